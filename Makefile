@@ -1,0 +1,83 @@
+# libdem / pydem — one entry point.
+#   make            static + shared library (strict warnings, warnings are errors)
+#   make test       set-up (idempotent), build, every C test, then the Python tests
+#   make bench      benchmarks (results in bench/results/)
+#   make demo       the main job
+#   make install PREFIX=/usr/local
+CC      ?= gcc
+PREFIX  ?= /usr/local
+BUILD   := build
+OPT     ?= -O3 -fno-math-errno
+CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem
+LDLIBS  += -lm
+PYTHON  := .venv/bin/python
+
+LIB_SRC := $(wildcard libdem/*.c)
+LIB_OBJ := $(patsubst libdem/%.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+HEADERS := $(wildcard include/dem/*.h) $(wildcard libdem/*.h)
+TEST_SRC := $(wildcard tests/c/test_*.c)
+TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+BENCH_SRC := $(wildcard bench/*.c)
+BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
+
+.PHONY: all lib setup test test-c test-py bench demo install clean
+
+all: lib
+lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
+
+$(BUILD)/obj/%.o: libdem/%.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -DDEM_BUILD_SHARED -c $< -o $@
+
+$(BUILD)/libdem.a: $(LIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/libdem.so: $(LIB_OBJ)
+	$(CC) -shared -fopenmp -o $@ $^ $(LDLIBS)
+
+$(BUILD)/dem.pc: Makefile
+	@mkdir -p $(BUILD)
+	printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nCflags: -I$${includedir}\n' \
+	  "$(PREFIX)" "$$(sed -n 's/#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)" > $@
+
+setup:
+	@sh scripts/setup.sh
+
+$(BUILD)/tests/%: tests/c/%.c tests/c/test_util.h $(BUILD)/libdem.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)
+
+test: setup
+	@$(MAKE) --no-print-directory test-c test-py
+
+test-c: lib $(TEST_BIN) $(BUILD)/readme_example
+	@set -e; for t in $(TEST_BIN); do echo "== $$t"; OMP_NUM_THREADS=2 $$t; done
+	@echo "== README example"; $(BUILD)/readme_example
+
+$(BUILD)/readme_example: README.md $(BUILD)/libdem.a
+	@mkdir -p $(BUILD)
+	sed -n '/^```c readme-example/,/^```/p' README.md | sed '1d;$$d' > $(BUILD)/readme_example.c
+	$(CC) $(CFLAGS) $(BUILD)/readme_example.c -o $@ $(BUILD)/libdem.a $(LDLIBS)
+
+test-py:
+	@if [ -d tests/py ]; then $(PYTHON) -m pytest -q tests/py; else echo "(no Python tests yet)"; fi
+
+$(BUILD)/bench/%: bench/%.c $(BUILD)/libdem.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a $(LDLIBS)
+
+bench: setup lib $(BENCH_BIN)
+	@sh bench/run_bench.sh
+
+demo: setup lib $(BUILD)/bench/packed_bed
+	$(BUILD)/bench/packed_bed --demo
+
+install: lib
+	install -d $(DESTDIR)$(PREFIX)/include/dem $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 include/dem/*.h $(DESTDIR)$(PREFIX)/include/dem/
+	install -m 644 $(BUILD)/libdem.a $(BUILD)/libdem.so $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 $(BUILD)/dem.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/dem.pc
+
+clean:
+	rm -rf $(BUILD)

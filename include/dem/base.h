@@ -1,0 +1,60 @@
+/* libdem — base definitions: version, status codes, export macro.
+ * Units are SI everywhere (m, kg, s, N, Pa, rad). */
+#ifndef DEM_BASE_H
+#define DEM_BASE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define DEM_VERSION_MAJOR 0
+#define DEM_VERSION_MINOR 1
+#define DEM_VERSION_PATCH 0
+#define DEM_VERSION_STRING "0.1.0"
+
+#if defined(_WIN32) && defined(DEM_BUILD_SHARED)
+#define DEM_API __declspec(dllexport)
+#elif defined(__GNUC__)
+#define DEM_API __attribute__((visibility("default")))
+#else
+#define DEM_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Status of every fallible call. Values are fixed and never renumbered.
+ * 0 is success, positive values are warnings (the call did its work),
+ * negative values are errors (the call did nothing, or stopped and says why).
+ * The words behind the last status live on the domain: dem_domain_last_error(). */
+typedef enum dem_status {
+    DEM_OK = 0,
+    DEM_WARN_TIMESTEP_LARGE = 1,  /* dt above 20 % of the Rayleigh time; stepped anyway */
+
+    DEM_ERR_NULL = -1,             /* a required pointer was NULL */
+    DEM_ERR_INVALID_ARGUMENT = -2, /* NaN, negative, out-of-range value */
+    DEM_ERR_NO_MEMORY = -3,
+    DEM_ERR_UNKNOWN_MATERIAL = -4,
+    DEM_ERR_UNKNOWN_PARTICLE = -5,
+    DEM_ERR_OVERLAP = -6,          /* insertion overlaps a particle or a wall */
+    DEM_ERR_OUT_OF_BOUNDS = -7,    /* particle outside the domain on a closed axis */
+    DEM_ERR_NUMERICAL = -8,        /* NaN/inf appeared in the state */
+    DEM_ERR_RUNAWAY_OVERLAP = -9,  /* overlap beyond max_overlap_ratio: dt too large or E too small */
+    DEM_ERR_UNSTABLE_TIMESTEP = -10, /* dt above the Rayleigh time: refused */
+    DEM_ERR_UNKNOWN_EFFECT = -11,
+    DEM_ERR_UNKNOWN_WALL = -12,
+    DEM_ERR_IO = -13,
+    DEM_ERR_FORMAT = -14
+} dem_status;
+
+/* Short fixed name of a status ("DEM_ERR_OVERLAP"); never NULL. */
+DEM_API const char *dem_status_name(dem_status status);
+
+/* Run-time version; compare with the DEM_VERSION_* macros to detect a mismatch. */
+DEM_API void dem_version(int *major, int *minor, int *patch);
+DEM_API const char *dem_version_string(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

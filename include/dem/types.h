@@ -1,0 +1,92 @@
+/* libdem — definition structs. Get one from dem_default_*_def(), tweak, pass to create/set. */
+#ifndef DEM_TYPES_H
+#define DEM_TYPES_H
+
+#include "base.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct dem_domain dem_domain; /* opaque */
+typedef int64_t dem_particle_id;       /* stable across sorting, removal and restarts */
+
+/* The simulation box. Closed axes: a particle leaving [lo, hi] is an error
+ * (DEM_ERR_OUT_OF_BOUNDS); periodic axes wrap. */
+typedef struct dem_domain_def {
+    double lo[3], hi[3];        /* m */
+    int periodic[3];            /* 0/1 per axis */
+    double gravity[3];          /* m/s^2, default (0, 0, -9.81) */
+    double dt;                  /* s, default 1e-5 */
+    double skin;                /* m, neighbour-list skin, default 2e-4 */
+    int num_threads;            /* OpenMP threads, default 1; results do not depend on it */
+    double max_overlap_ratio;   /* overlap / smaller radius that counts as runaway, default 0.3 */
+    double insert_overlap_ratio;/* overlap / smaller radius refused at insertion, default 1e-3 */
+    double reference_velocity;  /* m/s, impact speed for the Hertz contact-time estimate, default 1 */
+} dem_domain_def;
+
+/* Per-material constants. */
+typedef struct dem_material_def {
+    double youngs_modulus; /* E, Pa (> 0) */
+    double poisson_ratio;  /* nu, in (-1, 0.5) */
+    double density;        /* kg/m^3 (> 0); ignored for wall materials */
+} dem_material_def;
+
+/* Rolling resistance model; every model caps |M_r| <= mu_r R* |F_n|. */
+typedef enum dem_rolling_model {
+    DEM_ROLLING_CDT = 0,   /* constant directional torque -mu_r R* F_n w_rel/|w_rel| */
+    DEM_ROLLING_EPSD = 1,  /* elastic-plastic spring-dashpot, k_r = 2.25 k_n mu_r^2 R*^2 (Ai et al. 2011) */
+    DEM_ROLLING_EPSD2 = 2  /* spring k_r = k_t R*^2, no dashpot (seed 000 eq. 4); default */
+} dem_rolling_model;
+
+/* Constants of a material pair (particle–particle or particle–wall). */
+typedef struct dem_pair_def {
+    double restitution;       /* e in (0, 1]; delivered e equals this (damping is corrected) */
+    double friction;          /* mu_s >= 0, sliding (Coulomb) */
+    double rolling_friction;  /* mu_r >= 0 */
+    dem_rolling_model rolling_model;
+    double rolling_damping;   /* EPSD only: dashpot as a fraction of critical, >= 0, default 0 */
+} dem_pair_def;
+
+/* Axis-aligned analytic plane wall: the half-space the particles live in is
+ * x[axis] >= position when side = +1, x[axis] <= position when side = -1. */
+typedef struct dem_plane_wall_def {
+    int axis;          /* 0, 1, 2 */
+    int side;          /* +1 or -1: direction of the wall normal, pointing into the domain */
+    double position;   /* m */
+    int material;      /* wall material id */
+    double velocity[3];/* m/s, surface velocity felt by the contacts (the plane does not move) */
+} dem_plane_wall_def;
+
+/* Diagnostics of the current state. */
+typedef struct dem_diagnostics {
+    int64_t step;
+    double time;                 /* s */
+    int64_t particle_count;
+    int64_t contact_count;       /* particle–particle + particle–wall contacts with overlap > 0 */
+    double kinetic_energy;       /* J, translational + rotational */
+    double elastic_energy;       /* J, normal Hertz potential (8/15) E* sqrt(R*) d^(5/2) in the contacts */
+    double max_overlap_ratio;    /* max overlap / smaller radius */
+    double momentum[3];          /* kg m/s */
+} dem_diagnostics;
+
+/* Accumulated wall-clock time per phase since creation or the last reset. */
+typedef struct dem_profile {
+    double neighbor_s;     /* cell binning, sorting, Verlet list build, history transfer */
+    double contact_s;      /* pair and wall contact forces, force gathering */
+    double integrate_s;    /* velocity Verlet kicks and drift, checks */
+    int64_t steps;
+    int64_t neighbor_builds;
+} dem_profile;
+
+/* Time-step estimates for the current particles and materials. */
+typedef struct dem_timestep_info {
+    double rayleigh_time;       /* s, min over particles of pi R sqrt(rho/G)/(0.1631 nu + 0.8766) */
+    double hertz_contact_time;  /* s, head-on contact duration at reference_velocity, min over material pairs */
+    double suggested_dt;        /* s, min(0.1 rayleigh_time, hertz_contact_time / 50) */
+} dem_timestep_info;
+
+#ifdef __cplusplus
+}
+#endif
+#endif

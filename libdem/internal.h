@@ -1,0 +1,166 @@
+/* libdem internals: the domain struct and the functions the source files share. */
+#ifndef DEM_INTERNAL_H
+#define DEM_INTERNAL_H
+
+#include "dem/dem.h"
+#include <stdarg.h>
+
+#define DEM_MAX_EFFECTS_PER_PAIR 4
+#define DEM_MAX_EFFECT_PARAMS 4
+#define DEM_ERRMSG_SIZE 512
+#define DEM_PI 3.14159265358979323846
+
+/* One active effect on a material pair. */
+typedef struct pair_effect {
+    int effect;                          /* index into the effect registry */
+    double params[DEM_MAX_EFFECT_PARAMS];
+} pair_effect;
+
+/* Derived constants of a material pair, used by the contact law. */
+typedef struct pair_props {
+    dem_pair_def def;
+    double e_star;           /* effective Young's modulus E* */
+    double g_star;           /* effective shear modulus G* */
+    double damping_factor;   /* gamma = damping_factor * sqrt(S m*), restitution-corrected */
+    double st_over_sn_sqrt;  /* sqrt(S_t / S_n) = sqrt(4 G* / E*) */
+    int n_effects;
+    pair_effect effects[DEM_MAX_EFFECTS_PER_PAIR];
+} pair_props;
+
+typedef struct plane_wall {
+    dem_plane_wall_def def;
+    double normal[3];
+} plane_wall;
+
+/* Verlet neighbour list, half (j in row i has a larger index), CSR. Per entry: the
+ * partner, the periodic image code, tangential spring xi and rolling torque history. */
+typedef struct pair_list {
+    int64_t n_rows;       /* particles covered */
+    int64_t count, capacity;
+    int64_t *start;       /* n_rows + 1 */
+    int32_t *j;
+    uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
+    double *xi;           /* 3 per entry */
+    double *mr;           /* 3 per entry */
+} pair_list;
+
+/* Wall contact candidates, grouped by particle (CSR over particles). */
+typedef struct wall_list {
+    int64_t count, capacity;
+    int64_t *start;       /* n + 1 */
+    int32_t *wall;
+    double *xi, *mr;      /* 3 per entry */
+    double *force;        /* 3 per entry: force on the particle, last step */
+} wall_list;
+
+struct dem_domain {
+    dem_domain_def def;
+    char errmsg[DEM_ERRMSG_SIZE];
+
+    /* materials */
+    int n_materials, cap_materials;
+    dem_material_def *materials;
+    pair_props *pairs;        /* n_materials^2, symmetric */
+    unsigned char *pair_set;  /* n_materials^2 flags: set explicitly by the user */
+
+    /* particles, in internal (spatially sorted) order */
+    int64_t n, cap;
+    double *x, *v, *w;        /* 3n each: position, velocity, angular velocity */
+    double *f, *t;            /* 3n: contact force and torque of the last step */
+    double *x_build;          /* 3n: positions at the last neighbour build */
+    double *radius, *inv_mass, *inv_inertia;
+    int32_t *mat;
+    dem_particle_id *id;
+    dem_particle_id next_id;
+    int32_t *index_of_id;     /* next_id entries, -1 if removed */
+    int64_t cap_ids;
+
+    /* walls */
+    int n_walls, cap_walls;
+    plane_wall *walls;
+
+    /* neighbour search */
+    pair_list pairs_cur, pairs_old;
+    wall_list walls_cur, walls_old;
+    double *pair_force;       /* 3 per pair entry: force on j (= -force on i) */
+    double *pair_torque_j;    /* 3 per pair entry: torque on j */
+    int64_t *trans_start;     /* n + 1: entries where particle is the j partner */
+    int64_t *trans_entry;
+    int64_t trans_capacity;
+    int32_t *cell_of;         /* n */
+    int64_t *cell_start;      /* n_cells + 1 */
+    int64_t n_cells, cap_cells;
+    int32_t *perm;            /* new index -> old index (rebuild scratch) */
+    int64_t *cursor;          /* rebuild scratch for counting sorts */
+    int64_t cap_cursor;
+    double *scratch;          /* rebuild scratch, 3 cap */
+    int ncell[3];
+    double cell_size[3];
+    int need_rebuild;
+    double r_max;             /* largest radius present */
+
+    /* time */
+    int64_t step;
+    double time;
+    dem_profile profile;
+    double rayleigh_cache;    /* < 0: stale */
+    int bad_index;            /* numerical-failure scratch */
+    int forces_valid;         /* f/t belong to the current state */
+};
+
+/* error reporting: sets the message, returns status */
+dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+void dem_clear_error(dem_domain *d);
+
+/* materials.c */
+const pair_props *dem_pair_props(const dem_domain *d, int a, int b);
+void dem_pair_recompute(dem_domain *d, int a, int b);
+
+/* restitution.c: damping factor that delivers restitution e with a force clipped at zero */
+double dem_damping_factor_for_restitution(double e);
+/* delivered restitution of the continuous clipped model for a damping factor (for tests) */
+double dem_restitution_for_damping_factor(double factor);
+
+/* neighbor.c */
+dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask);
+int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
+
+/* forces.c: contact forces of the current state into f/t (row part) and the entries
+ * (reaction part); dem_forces_gather adds the reactions of particle i. */
+dem_status dem_forces_compute(dem_domain *d, double dt_hist);
+void dem_forces_gather(const dem_domain *d, int64_t i, double *f, double *t);
+
+/* step.c */
+double dem_rayleigh_time(dem_domain *d);
+
+/* effects.c */
+typedef struct dem_effect_contact {
+    double n[3];        /* unit normal, from partner towards particle i */
+    double overlap;     /* m */
+    double distance;    /* m, centre distance (pair) or centre-to-plane distance (wall) */
+    double radius_i, radius_j; /* radius_j = 0 for a wall */
+    double normal_force;/* N, repulsive elastic + damping part already computed (>= 0) */
+} dem_effect_contact;
+typedef struct dem_effect_param {
+    const char *name, *unit;
+    double neutral, min, max;
+} dem_effect_param;
+typedef struct dem_effect_desc {
+    const char *name, *summary;
+    int n_params;
+    dem_effect_param params[DEM_MAX_EFFECT_PARAMS];
+    /* returns the extra normal force (N, positive = repulsive) */
+    double (*normal_force)(const dem_effect_contact *c, const double *params);
+} dem_effect_desc;
+const dem_effect_desc *dem_effect_get(int index);
+int dem_effect_find(const char *name);
+
+/* small helpers */
+void *dem_realloc_array(void *p, size_t count, size_t elem);
+int dem_is_finite(double x);
+
+#endif

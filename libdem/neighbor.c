@@ -1,0 +1,359 @@
+/* Neighbour search: linked cells -> spatial sort of the particles -> half Verlet list
+ * with skin (CSR), wall candidate list, and transfer of the contact histories from the
+ * previous list. Everything is deterministic whatever the thread count: counting sort
+ * by cell, rows filled in a fixed stencil order, transposed list filled serially. */
+#include "internal.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define IMAGE_NONE 13
+
+static int grow(void **p, int64_t *cap, int64_t need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    int64_t c = *cap > 0 ? *cap : 64;
+    while (c < need) c *= 2;
+    void *q = dem_realloc_array(*p, (size_t)c, elem);
+    if (!q) return 0;
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+/* Grow a pair list's per-entry arrays to hold `need` entries. */
+static int pair_list_reserve(pair_list *pl, int64_t need)
+{
+    if (need <= pl->capacity) return 1;
+    int64_t c = pl->capacity > 0 ? pl->capacity : 256;
+    while (c < need) c *= 2;
+    int32_t *j = dem_realloc_array(pl->j, (size_t)c, sizeof *j);
+    if (j) pl->j = j;
+    uint8_t *im = dem_realloc_array(pl->image, (size_t)c, 1);
+    if (im) pl->image = im;
+    double *xi = dem_realloc_array(pl->xi, (size_t)c * 3, sizeof *xi);
+    if (xi) pl->xi = xi;
+    double *mr = dem_realloc_array(pl->mr, (size_t)c * 3, sizeof *mr);
+    if (mr) pl->mr = mr;
+    if (!j || !im || !xi || !mr) return 0;
+    pl->capacity = c;
+    return 1;
+}
+
+static int wall_list_reserve(wall_list *wl, int64_t need)
+{
+    if (need <= wl->capacity) return 1;
+    int64_t c = wl->capacity > 0 ? wl->capacity : 64;
+    while (c < need) c *= 2;
+    int32_t *w = dem_realloc_array(wl->wall, (size_t)c, sizeof *w);
+    if (w) wl->wall = w;
+    double *xi = dem_realloc_array(wl->xi, (size_t)c * 3, sizeof *xi);
+    if (xi) wl->xi = xi;
+    double *mr = dem_realloc_array(wl->mr, (size_t)c * 3, sizeof *mr);
+    if (mr) wl->mr = mr;
+    double *f = dem_realloc_array(wl->force, (size_t)c * 3, sizeof *f);
+    if (f) wl->force = f;
+    if (!w || !xi || !mr || !f) return 0;
+    wl->capacity = c;
+    return 1;
+}
+
+/* Choose the cell grid: cells at least as large as the cut-off, at most ~2 per particle. */
+static dem_status choose_cells(dem_domain *d, int64_t n_live)
+{
+    const double cutoff = 2.0 * d->r_max + d->def.skin;
+    int64_t limit = 2 * n_live + 1024;
+    for (int a = 0; a < 3; a++) {
+        double len = d->def.hi[a] - d->def.lo[a];
+        int nc = (int)floor(len / cutoff);
+        if (nc < 1) nc = 1;
+        if (nc > 1 << 20) nc = 1 << 20;
+        if (d->def.periodic[a] && nc < 3)
+            return dem_fail(d, DEM_ERR_INVALID_ARGUMENT,
+                            "periodic axis %d is %g m long; it must be at least 3 x (2 R_max + skin) = %g m", a, len,
+                            3 * cutoff);
+        d->ncell[a] = nc;
+    }
+    for (;;) {
+        int64_t total = (int64_t)d->ncell[0] * d->ncell[1] * d->ncell[2];
+        if (total <= limit) break;
+        int a = 0;
+        for (int b = 1; b < 3; b++)
+            if (d->ncell[b] > d->ncell[a]) a = b;
+        int nc = (d->ncell[a] + 1) / 2;
+        if (d->def.periodic[a] && nc < 3) nc = 3;
+        if (nc == d->ncell[a]) break;
+        d->ncell[a] = nc;
+    }
+    for (int a = 0; a < 3; a++) d->cell_size[a] = (d->def.hi[a] - d->def.lo[a]) / d->ncell[a];
+    d->n_cells = (int64_t)d->ncell[0] * d->ncell[1] * d->ncell[2];
+    return DEM_OK;
+}
+
+static inline int cell_coord(const dem_domain *d, double x, int a)
+{
+    double c = floor((x - d->def.lo[a]) / d->cell_size[a]); /* clamp before the cast */
+    if (!(c >= 0.0)) return 0;
+    if (c >= d->ncell[a]) return d->ncell[a] - 1;
+    return (int)c;
+}
+
+/* Permute a particle array (elements of elem_bytes) into the new order. */
+static void permute(void *arr, const int32_t *perm, int64_t n, size_t elem_bytes, void *scratch)
+{
+    char *src = arr, *dst = scratch;
+    for (int64_t i = 0; i < n; i++) memcpy(dst + (size_t)i * elem_bytes, src + (size_t)perm[i] * elem_bytes, elem_bytes);
+    memcpy(arr, scratch, (size_t)n * elem_bytes);
+}
+
+/* The 13 forward neighbour cells (half stencil); the own cell is handled with j > i. */
+static const int half_stencil[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0},  {-1, -1, 1},
+                                        {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1},  {1, 0, 1},
+                                        {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
+
+/* Candidate partners of particle i; with out_j == NULL only counts them. */
+static int64_t scan_row(const dem_domain *d, int64_t i, int32_t *out_j, uint8_t *out_image)
+{
+    const double *x = d->x;
+    const double skin = d->def.skin;
+    const double ri = d->radius[i];
+    int c[3];
+    int64_t cell = d->cell_of[i];
+    c[0] = (int)(cell % d->ncell[0]);
+    c[1] = (int)((cell / d->ncell[0]) % d->ncell[1]);
+    c[2] = (int)(cell / ((int64_t)d->ncell[0] * d->ncell[1]));
+    int64_t count = 0;
+    /* own cell: later particles */
+    for (int64_t j = i + 1; j < d->cell_start[cell + 1]; j++) {
+        double dx = x[3 * i] - x[3 * j], dy = x[3 * i + 1] - x[3 * j + 1], dz = x[3 * i + 2] - x[3 * j + 2];
+        double cut = ri + d->radius[j] + skin;
+        if (dx * dx + dy * dy + dz * dz < cut * cut) {
+            if (out_j) {
+                out_j[count] = (int32_t)j;
+                out_image[count] = IMAGE_NONE;
+            }
+            count++;
+        }
+    }
+    for (int s = 0; s < 13; s++) {
+        int nc[3], sh[3];
+        int skip = 0;
+        for (int a = 0; a < 3; a++) {
+            nc[a] = c[a] + half_stencil[s][a];
+            sh[a] = 0;
+            if (nc[a] < 0 || nc[a] >= d->ncell[a]) {
+                if (!d->def.periodic[a]) {
+                    skip = 1;
+                    break;
+                }
+                sh[a] = nc[a] < 0 ? -1 : 1;
+                nc[a] -= sh[a] * d->ncell[a];
+            }
+        }
+        if (skip) continue;
+        double shift[3];
+        for (int a = 0; a < 3; a++) shift[a] = sh[a] * (d->def.hi[a] - d->def.lo[a]);
+        int64_t ncell = ((int64_t)nc[2] * d->ncell[1] + nc[1]) * d->ncell[0] + nc[0];
+        uint8_t image = (uint8_t)((sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1));
+        for (int64_t j = d->cell_start[ncell]; j < d->cell_start[ncell + 1]; j++) {
+            double dx = x[3 * i] - (x[3 * j] + shift[0]);
+            double dy = x[3 * i + 1] - (x[3 * j + 1] + shift[1]);
+            double dz = x[3 * i + 2] - (x[3 * j + 2] + shift[2]);
+            double cut = ri + d->radius[j] + skin;
+            if (dx * dx + dy * dy + dz * dz < cut * cut) {
+                if (out_j) {
+                    out_j[count] = (int32_t)j;
+                    out_image[count] = image;
+                }
+                count++;
+            }
+        }
+    }
+    return count;
+}
+
+/* Copy the history of pair (old oa, old ob) into xi/mr, or zero them when new. */
+static void transfer_pair_history(const pair_list *old, int64_t old_rows, int32_t oa, int32_t ob, double *xi,
+                                  double *mr)
+{
+    for (int pass = 0; pass < 2; pass++) {
+        int32_t r = pass ? ob : oa, want = pass ? oa : ob;
+        if (r < 0 || r >= old_rows) continue;
+        for (int64_t k = old->start[r]; k < old->start[r + 1]; k++) {
+            if (old->j[k] == want) {
+                double sgn = pass ? -1.0 : 1.0; /* the history is seen from the row particle */
+                for (int a = 0; a < 3; a++) {
+                    xi[a] = sgn * old->xi[3 * k + a];
+                    mr[a] = sgn * old->mr[3 * k + a];
+                }
+                return;
+            }
+        }
+    }
+    xi[0] = xi[1] = xi[2] = 0.0;
+    mr[0] = mr[1] = mr[2] = 0.0;
+}
+
+dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
+{
+    const int64_t n_old = d->n;
+    const int nt = d->def.num_threads;
+
+    /* live particles, largest radius */
+    int64_t n = 0;
+    double rmax = 0.0;
+    for (int64_t i = 0; i < n_old; i++) {
+        if (remove_mask && remove_mask[i]) continue;
+        n++;
+        if (d->radius[i] > rmax) rmax = d->radius[i];
+    }
+    d->r_max = rmax;
+    dem_status s = choose_cells(d, n);
+    if (s != DEM_OK) return s;
+
+    /* wrap periodic axes (positions drift out by < skin between builds) */
+    for (int64_t i = 0; i < n_old; i++)
+        for (int a = 0; a < 3; a++)
+            if (d->def.periodic[a]) {
+                double len = d->def.hi[a] - d->def.lo[a];
+                double *xa = &d->x[3 * i + a];
+                if (*xa < d->def.lo[a] || *xa >= d->def.hi[a]) {
+                    *xa -= floor((*xa - d->def.lo[a]) / len) * len;
+                    if (*xa >= d->def.hi[a]) *xa = d->def.lo[a]; /* rounding at the upper edge */
+                }
+            }
+
+    /* counting sort by cell (stable, so deterministic) */
+    int64_t tmp_cap = d->cap_cells;
+    if (!grow((void **)&d->cell_start, &tmp_cap, d->n_cells + 1, sizeof *d->cell_start))
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for %lld cells", (long long)d->n_cells);
+    d->cap_cells = tmp_cap;
+    memset(d->cell_start, 0, (size_t)(d->n_cells + 1) * sizeof *d->cell_start);
+    for (int64_t i = 0; i < n_old; i++) {
+        if (remove_mask && remove_mask[i]) {
+            d->cell_of[i] = -1;
+            continue;
+        }
+        int64_t c = ((int64_t)cell_coord(d, d->x[3 * i + 2], 2) * d->ncell[1] + cell_coord(d, d->x[3 * i + 1], 1)) *
+                        d->ncell[0] +
+                    cell_coord(d, d->x[3 * i], 0);
+        d->cell_of[i] = (int32_t)c;
+        d->cell_start[c + 1]++;
+    }
+    for (int64_t c = 0; c < d->n_cells; c++) d->cell_start[c + 1] += d->cell_start[c];
+    int64_t need_cursor = (d->n_cells > n_old ? d->n_cells : n_old) + 1;
+    if (!grow((void **)&d->cursor, &d->cap_cursor, need_cursor, sizeof *d->cursor))
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    int64_t *cursor = d->cursor;
+    memcpy(cursor, d->cell_start, (size_t)(d->n_cells + 1) * sizeof *cursor);
+    for (int64_t i = 0; i < n_old; i++) /* perm[new] = old */
+        if (d->cell_of[i] >= 0) d->perm[cursor[d->cell_of[i]]++] = (int32_t)i;
+
+    /* reorder particle arrays */
+    void *scr = d->scratch;
+    permute(d->x, d->perm, n, 3 * sizeof(double), scr);
+    permute(d->v, d->perm, n, 3 * sizeof(double), scr);
+    permute(d->w, d->perm, n, 3 * sizeof(double), scr);
+    permute(d->radius, d->perm, n, sizeof(double), scr);
+    permute(d->inv_mass, d->perm, n, sizeof(double), scr);
+    permute(d->inv_inertia, d->perm, n, sizeof(double), scr);
+    permute(d->mat, d->perm, n, sizeof(int32_t), scr);
+    permute(d->id, d->perm, n, sizeof(dem_particle_id), scr);
+    d->n = n;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t c = ((int64_t)cell_coord(d, d->x[3 * i + 2], 2) * d->ncell[1] + cell_coord(d, d->x[3 * i + 1], 1)) *
+                        d->ncell[0] +
+                    cell_coord(d, d->x[3 * i], 0);
+        d->cell_of[i] = (int32_t)c;
+    }
+    for (dem_particle_id k = 0; k < d->next_id; k++) d->index_of_id[k] = -1;
+    for (int64_t i = 0; i < n; i++) d->index_of_id[d->id[i]] = (int32_t)i;
+    memcpy(d->x_build, d->x, (size_t)n * 3 * sizeof(double));
+
+    /* swap the lists: the old one keeps the histories, indexed by old particle index */
+    pair_list tp = d->pairs_old;
+    d->pairs_old = d->pairs_cur;
+    d->pairs_cur = tp;
+    wall_list tw = d->walls_old;
+    d->walls_old = d->walls_cur;
+    d->walls_cur = tw;
+    pair_list *pl = &d->pairs_cur;
+    const pair_list *old = &d->pairs_old;
+    const int64_t old_rows = old->start ? old->n_rows : 0;
+
+    /* pair list: count, prefix, fill */
+    int64_t *start = dem_realloc_array(pl->start, (size_t)n + 1, sizeof *start);
+    if (!start) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    pl->start = start;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int64_t i = 0; i < n; i++) start[i + 1] = scan_row(d, i, NULL, NULL);
+    start[0] = 0;
+    for (int64_t i = 0; i < n; i++) start[i + 1] += start[i];
+    const int64_t count = start[n];
+    if (!pair_list_reserve(pl, count))
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for %lld pairs", (long long)count);
+    pl->count = count;
+    pl->n_rows = n;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int64_t i = 0; i < n; i++) {
+        scan_row(d, i, pl->j + start[i], pl->image + start[i]);
+        for (int64_t k = start[i]; k < start[i + 1]; k++)
+            transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl->xi + 3 * k, pl->mr + 3 * k);
+    }
+
+    /* per-entry force scratch and the transposed list (entries where a particle is j) */
+    if (count > d->trans_capacity) {
+        int64_t c = d->trans_capacity > 0 ? d->trans_capacity : 256;
+        while (c < count) c *= 2;
+        double *pf = dem_realloc_array(d->pair_force, (size_t)c * 3, sizeof *pf);
+        if (pf) d->pair_force = pf;
+        double *pt = dem_realloc_array(d->pair_torque_j, (size_t)c * 3, sizeof *pt);
+        if (pt) d->pair_torque_j = pt;
+        int64_t *te = dem_realloc_array(d->trans_entry, (size_t)c, sizeof *te);
+        if (te) d->trans_entry = te;
+        if (!pf || !pt || !te) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+        d->trans_capacity = c;
+    }
+    memset(d->trans_start, 0, (size_t)(n + 1) * sizeof *d->trans_start);
+    for (int64_t k = 0; k < count; k++) d->trans_start[pl->j[k] + 1]++;
+    for (int64_t i = 0; i < n; i++) d->trans_start[i + 1] += d->trans_start[i];
+    memcpy(cursor, d->trans_start, (size_t)(n + 1) * sizeof *cursor);
+    for (int64_t k = 0; k < count; k++) d->trans_entry[cursor[pl->j[k]]++] = k; /* entry order */
+
+    /* wall candidates, grouped by particle */
+    wall_list *wl = &d->walls_cur;
+    const wall_list *wold = &d->walls_old;
+    int64_t *wstart = dem_realloc_array(wl->start, (size_t)n + 1, sizeof *wstart);
+    if (!wstart) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    wl->start = wstart;
+    int64_t wc = 0;
+    wstart[0] = 0;
+    for (int64_t i = 0; i < n; i++) {
+        for (int w = 0; w < d->n_walls; w++) {
+            const plane_wall *pw = &d->walls[w];
+            double dist = (d->x[3 * i + pw->def.axis] - pw->def.position) * pw->def.side;
+            if (dist < d->radius[i] + d->def.skin) {
+                if (!wall_list_reserve(wl, wc + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+                wl->wall[wc] = w;
+                /* history from the old list */
+                int32_t oi = d->perm[i];
+                double *xi = wl->xi + 3 * wc, *mr = wl->mr + 3 * wc;
+                xi[0] = xi[1] = xi[2] = mr[0] = mr[1] = mr[2] = 0.0;
+                if (wold->start && oi < old_rows)
+                    for (int64_t k = wold->start[oi]; k < wold->start[oi + 1]; k++)
+                        if (wold->wall[k] == w) {
+                            memcpy(xi, wold->xi + 3 * k, 3 * sizeof(double));
+                            memcpy(mr, wold->mr + 3 * k, 3 * sizeof(double));
+                        }
+                wl->force[3 * wc] = wl->force[3 * wc + 1] = wl->force[3 * wc + 2] = 0.0;
+                wc++;
+            }
+        }
+        wstart[i + 1] = wc;
+    }
+    wl->count = wc;
+
+    d->need_rebuild = 0;
+    d->profile.neighbor_builds++;
+    return DEM_OK;
+}

@@ -1,0 +1,60 @@
+/* Status names, version, error messages and small helpers. */
+#include "internal.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+const char *dem_status_name(dem_status s)
+{
+    switch (s) {
+    case DEM_OK: return "DEM_OK";
+    case DEM_WARN_TIMESTEP_LARGE: return "DEM_WARN_TIMESTEP_LARGE";
+    case DEM_ERR_NULL: return "DEM_ERR_NULL";
+    case DEM_ERR_INVALID_ARGUMENT: return "DEM_ERR_INVALID_ARGUMENT";
+    case DEM_ERR_NO_MEMORY: return "DEM_ERR_NO_MEMORY";
+    case DEM_ERR_UNKNOWN_MATERIAL: return "DEM_ERR_UNKNOWN_MATERIAL";
+    case DEM_ERR_UNKNOWN_PARTICLE: return "DEM_ERR_UNKNOWN_PARTICLE";
+    case DEM_ERR_OVERLAP: return "DEM_ERR_OVERLAP";
+    case DEM_ERR_OUT_OF_BOUNDS: return "DEM_ERR_OUT_OF_BOUNDS";
+    case DEM_ERR_NUMERICAL: return "DEM_ERR_NUMERICAL";
+    case DEM_ERR_RUNAWAY_OVERLAP: return "DEM_ERR_RUNAWAY_OVERLAP";
+    case DEM_ERR_UNSTABLE_TIMESTEP: return "DEM_ERR_UNSTABLE_TIMESTEP";
+    case DEM_ERR_UNKNOWN_EFFECT: return "DEM_ERR_UNKNOWN_EFFECT";
+    case DEM_ERR_UNKNOWN_WALL: return "DEM_ERR_UNKNOWN_WALL";
+    case DEM_ERR_IO: return "DEM_ERR_IO";
+    case DEM_ERR_FORMAT: return "DEM_ERR_FORMAT";
+    }
+    return "DEM_UNKNOWN_STATUS";
+}
+
+void dem_version(int *major, int *minor, int *patch)
+{
+    if (major) *major = DEM_VERSION_MAJOR;
+    if (minor) *minor = DEM_VERSION_MINOR;
+    if (patch) *patch = DEM_VERSION_PATCH;
+}
+
+const char *dem_version_string(void) { return DEM_VERSION_STRING; }
+
+dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)
+{
+    if (!d) return s;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(d->errmsg, sizeof d->errmsg, fmt, ap);
+    va_end(ap);
+    return s;
+}
+
+void dem_clear_error(dem_domain *d) { d->errmsg[0] = '\0'; }
+
+const char *dem_domain_last_error(const dem_domain *d) { return d ? d->errmsg : "domain is NULL"; }
+
+void *dem_realloc_array(void *p, size_t count, size_t elem)
+{
+    if (count == 0) count = 1;
+    if (count > SIZE_MAX / elem) return NULL;
+    return realloc(p, count * elem);
+}
+
+int dem_is_finite(double x) { return isfinite(x) ? 1 : 0; }

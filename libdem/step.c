@@ -1,0 +1,207 @@
+/* Time stepping: velocity Verlet (kick-drift, forces, kick), neighbour-list refresh when
+ * a particle has moved half the skin, failure detection that names the particle, and the
+ * time-step checks (Rayleigh time). */
+#define _POSIX_C_SOURCE 200809L
+#include "internal.h"
+#include <float.h>
+#include <math.h>
+#include <time.h>
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double dem_rayleigh_time(dem_domain *d)
+{
+    if (d->rayleigh_cache >= 0.0) return d->rayleigh_cache;
+    double tmin = INFINITY;
+    for (int64_t i = 0; i < d->n; i++) {
+        const dem_material_def *m = &d->materials[d->mat[i]];
+        double g = m->youngs_modulus / (2.0 * (1.0 + m->poisson_ratio));
+        double t = DEM_PI * d->radius[i] * sqrt(m->density / g) / (0.1631 * m->poisson_ratio + 0.8766);
+        if (t < tmin) tmin = t;
+    }
+    d->rayleigh_cache = tmin;
+    return tmin;
+}
+
+/* Duration of a head-on Hertz impact at speed v (elastic): 2.94328 d_max / v. */
+static double hertz_time(double e_star, double r_eff, double m_eff, double v)
+{
+    double dmax = pow(15.0 * m_eff * v * v / (16.0 * e_star * sqrt(r_eff)), 0.4);
+    return 2.94328 * dmax / v;
+}
+
+dem_status dem_domain_timestep_info(dem_domain *d, dem_timestep_info *info)
+{
+    if (!d) return DEM_ERR_NULL;
+    if (!info) return dem_fail(d, DEM_ERR_NULL, "dem_domain_timestep_info: info must not be NULL");
+    if (d->n == 0) return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_domain_timestep_info: no particles yet");
+    const int nm = d->n_materials;
+    /* smallest particle per material */
+    double rmin[64];
+    int nmm = nm < 64 ? nm : 64;
+    for (int a = 0; a < nmm; a++) rmin[a] = INFINITY;
+    for (int64_t i = 0; i < d->n; i++)
+        if (d->mat[i] < nmm && d->radius[i] < rmin[d->mat[i]]) rmin[d->mat[i]] = d->radius[i];
+    const double v = d->def.reference_velocity;
+    double tc = INFINITY;
+    for (int a = 0; a < nmm; a++) {
+        if (!isfinite(rmin[a])) continue;
+        double ma = d->materials[a].density * 4.0 / 3.0 * DEM_PI * pow(rmin[a], 3);
+        for (int b = a; b < nmm; b++) {
+            if (!isfinite(rmin[b])) continue;
+            double mb = d->materials[b].density * 4.0 / 3.0 * DEM_PI * pow(rmin[b], 3);
+            double t = hertz_time(dem_pair_props(d, a, b)->e_star, rmin[a] * rmin[b] / (rmin[a] + rmin[b]),
+                                  ma * mb / (ma + mb), v);
+            if (t < tc) tc = t;
+        }
+        for (int w = 0; w < d->n_walls; w++) {
+            double t = hertz_time(dem_pair_props(d, a, d->walls[w].def.material)->e_star, rmin[a], ma, v);
+            if (t < tc) tc = t;
+        }
+    }
+    info->rayleigh_time = dem_rayleigh_time(d);
+    info->hertz_contact_time = tc;
+    info->suggested_dt = fmin(0.1 * info->rayleigh_time, tc / 50.0);
+    dem_clear_error(d);
+    return DEM_OK;
+}
+
+/* Make f/t complete for the current state (after insertion, removal, velocity changes):
+ * forces with no spring increment, then the reactions gathered. */
+static dem_status refresh_forces(dem_domain *d)
+{
+    if (d->need_rebuild) {
+        dem_status s = dem_neighbor_rebuild(d, NULL);
+        if (s != DEM_OK) return s;
+    }
+    dem_status s = dem_forces_compute(d, 0.0);
+    if (s != DEM_OK) return s;
+    const int64_t n = d->n;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads)
+    for (int64_t i = 0; i < n; i++) dem_forces_gather(d, i, d->f + 3 * i, d->t + 3 * i);
+    d->forces_valid = 1;
+    return DEM_OK;
+}
+
+dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
+{
+    if (!d) return DEM_ERR_NULL;
+    if (n_steps < 0)
+        return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_domain_step: n_steps must be >= 0, got %lld", (long long)n_steps);
+    const double dt = d->def.dt;
+    dem_status result = DEM_OK;
+    dem_clear_error(d);
+    if (d->n == 0) {
+        d->step += n_steps;
+        d->time += (double)n_steps * dt;
+        return DEM_OK;
+    }
+    const double tr = dem_rayleigh_time(d);
+    if (dt > tr)
+        return dem_fail(d, DEM_ERR_UNSTABLE_TIMESTEP,
+                        "dem_domain_step: dt = %g s exceeds the Rayleigh time %g s; the explicit scheme is unstable "
+                        "(use <= %g s)",
+                        dt, tr, 0.2 * tr);
+    if (dt > 0.2 * tr) {
+        dem_fail(d, DEM_WARN_TIMESTEP_LARGE, "dt = %g s is %.0f %% of the Rayleigh time %g s (recommended <= 20 %%)", dt,
+                 100.0 * dt / tr, tr);
+        result = DEM_WARN_TIMESTEP_LARGE;
+    }
+    if (d->need_rebuild || !d->forces_valid) {
+        double t0 = now_s();
+        dem_status s = refresh_forces(d);
+        d->profile.neighbor_s += now_s() - t0;
+        if (s != DEM_OK) return s;
+    }
+
+    const int nt = d->def.num_threads;
+    const double half = 0.5 * dt;
+    const double *g = d->def.gravity;
+    const double skin_half2 = 0.25 * d->def.skin * d->def.skin;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
+        hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
+    }
+
+    for (int64_t s = 0; s < n_steps; s++) {
+        const int64_t n = d->n;
+        double *x = d->x, *v = d->v, *w = d->w, *f = d->f, *t = d->t;
+        const double *xb = d->x_build, *im = d->inv_mass, *ii = d->inv_inertia;
+        double t0 = now_s();
+        /* kick (half) + drift */
+        double maxdisp2 = 0.0;
+        int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
+#pragma omp parallel for schedule(static) num_threads(nt) reduction(max : maxdisp2) reduction(min : bad_nan, bad_out)
+        for (int64_t i = 0; i < n; i++) {
+            double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
+            const double *fi = f + 3 * i, *ti = t + 3 * i;
+            double disp2 = 0.0;
+            int ok = 1, in = 1;
+            for (int a = 0; a < 3; a++) {
+                vi[a] += half * (fi[a] * im[i] + g[a]);
+                wi[a] += half * ti[a] * ii[i];
+                xi[a] += dt * vi[a];
+                double u = xi[a] - xb[3 * i + a];
+                disp2 += u * u;
+                ok &= isfinite(xi[a]) && isfinite(vi[a]) && isfinite(wi[a]);
+                in &= xi[a] >= lo[a] && xi[a] <= hi[a];
+            }
+            if (disp2 > maxdisp2) maxdisp2 = disp2;
+            if (!ok && i < bad_nan) bad_nan = i;
+            if (ok && !in && i < bad_out) bad_out = i;
+        }
+        double t1 = now_s();
+        d->profile.integrate_s += t1 - t0;
+        if (bad_nan != INT64_MAX) {
+            d->forces_valid = 0;
+            return dem_fail(d, DEM_ERR_NUMERICAL,
+                            "step %lld: particle id %lld has a non-finite position or velocity (NaN/inf)",
+                            (long long)d->step, (long long)d->id[bad_nan]);
+        }
+        if (bad_out != INT64_MAX) {
+            const double *p = x + 3 * bad_out;
+            d->forces_valid = 0;
+            return dem_fail(d, DEM_ERR_OUT_OF_BOUNDS, "step %lld: particle id %lld left the domain at (%g, %g, %g)",
+                            (long long)d->step, (long long)d->id[bad_out], p[0], p[1], p[2]);
+        }
+        if (maxdisp2 > skin_half2) {
+            dem_status st = dem_neighbor_rebuild(d, NULL);
+            if (st != DEM_OK) return st;
+            x = d->x;
+            v = d->v;
+            w = d->w;
+            f = d->f;
+            t = d->t;
+        }
+        double t2 = now_s();
+        d->profile.neighbor_s += t2 - t1;
+        dem_status st = dem_forces_compute(d, dt);
+        if (st != DEM_OK) {
+            d->forces_valid = 0;
+            return st;
+        }
+        /* gather reactions + kick (half) */
+        const double *im2 = d->inv_mass, *ii2 = d->inv_inertia;
+#pragma omp parallel for schedule(static) num_threads(nt)
+        for (int64_t i = 0; i < n; i++) {
+            double *fi = f + 3 * i, *ti = t + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
+            dem_forces_gather(d, i, fi, ti);
+            for (int a = 0; a < 3; a++) {
+                vi[a] += half * (fi[a] * im2[i] + g[a]);
+                wi[a] += half * ti[a] * ii2[i];
+            }
+        }
+        double t3 = now_s();
+        d->profile.contact_s += t3 - t2;
+        d->step++;
+        d->time += dt;
+        d->profile.steps++;
+    }
+    return result;
+}
