@@ -10,6 +10,7 @@
 #include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dem/dem.h"
@@ -18,11 +19,15 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* |actual - expected| <= atol + rtol |expected|; prints both on failure. */
+/* |actual - expected| <= atol + rtol |expected|; prints both on failure, and always when
+ * DEM_TEST_VERBOSE is set (to see how much margin a tolerance has). */
 #define assert_close(actual, expected, rtol, atol)                                                              \
     do {                                                                                                        \
         double a_ = (actual), e_ = (expected);                                                                  \
         double tol_ = (atol) + (rtol) * fabs(e_);                                                               \
+        if (getenv("DEM_TEST_VERBOSE"))                                                                         \
+            printf("  %s = %.9g, expected %.9g, rel err %.2e (tol %.1e)\n", #actual, a_, e_,                    \
+                   e_ != 0 ? fabs(a_ - e_) / fabs(e_) : fabs(a_ - e_), tol_ / (e_ != 0 ? fabs(e_) : 1.0));       \
         if (!(fabs(a_ - e_) <= tol_)) {                                                                         \
             print_error("%s = %.12g, expected %.12g (tol %.3g, rel err %.3g)\n", #actual, a_, e_, tol_,        \
                         e_ != 0 ? fabs(a_ - e_) / fabs(e_) : fabs(a_ - e_));                                   \
