@@ -10,6 +10,41 @@ static const double image_sign[27][3] = {
     {-1, -1, 0},  {0, -1, 0},  {1, -1, 0},  {-1, 0, 0},  {0, 0, 0},  {1, 0, 0},  {-1, 1, 0},  {0, 1, 0},  {1, 1, 0},
     {-1, -1, 1},  {0, -1, 1},  {1, -1, 1},  {-1, 0, 1},  {0, 0, 1},  {1, 0, 1},  {-1, 1, 1},  {0, 1, 1},  {1, 1, 1}};
 
+/* Cold path: name the contact of row particle i whose overlap exceeds the limit. */
+static dem_status report_runaway(dem_domain *d, int64_t i, double (*shift)[3])
+{
+    const pair_list *pl = &d->pairs_cur;
+    const wall_list *wl = &d->walls_cur;
+    const double ratio = d->def.max_overlap_ratio, ri = d->radius[i];
+    const char *why = "(time step too large for the stiffness and speeds, or particles inserted into each other)";
+    for (int64_t k = pl->start[i]; k < pl->start[i + 1]; k++) {
+        int32_t j = pl->j[k];
+        double r2 = 0;
+        for (int a = 0; a < 3; a++) {
+            double u = d->x[3 * i + a] - d->x[3 * j + a] - shift[pl->image[k]][a];
+            r2 += u * u;
+        }
+        double delta = ri + d->radius[j] - sqrt(r2), rmin = ri < d->radius[j] ? ri : d->radius[j];
+        if (delta > ratio * rmin)
+            return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
+                            "runaway overlap during step %lld: particles id %lld and id %lld overlap by %g m, %.2f of "
+                            "the smaller radius (limit %g) %s",
+                            (long long)d->step + 1, (long long)d->id[i], (long long)d->id[j], delta, delta / rmin,
+                            ratio, why);
+    }
+    for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++) {
+        const plane_wall *pw = &d->walls[wl->wall[k]];
+        double delta = ri - (d->x[3 * i + pw->def.axis] - pw->def.position) * pw->def.side;
+        if (delta > ratio * ri)
+            return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
+                            "runaway overlap during step %lld: particle id %lld overlaps plane wall %d by %g m, %.2f "
+                            "of its radius (limit %g) %s",
+                            (long long)d->step + 1, (long long)d->id[i], wl->wall[k], delta, delta / ri, ratio, why);
+    }
+    return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP, "runaway overlap during step %lld at particle id %lld %s",
+                    (long long)d->step + 1, (long long)d->id[i], why);
+}
+
 /* dt_hist: time increment for the spring histories (0 for a force refresh without motion). */
 dem_status dem_forces_compute(dem_domain *d, double dt_hist)
 {
@@ -141,13 +176,7 @@ dem_status dem_forces_compute(dem_domain *d, double dt_hist)
         t[1] = ti[1];
         t[2] = ti[2];
     }
-    if (bad != INT64_MAX) {
-        d->bad_index = (int)bad;
-        return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
-                        "runaway overlap at step %lld: particle id %lld overlaps by more than %g of its radius "
-                        "(time step too large for the stiffness, or particles inserted into each other)",
-                        (long long)d->step, (long long)d->id[bad], ratio);
-    }
+    if (bad != INT64_MAX) return report_runaway(d, bad, shift);
     return DEM_OK;
 }
 

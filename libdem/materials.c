@@ -137,6 +137,7 @@ dem_status dem_pair_set(dem_domain *d, int a, int b, const dem_pair_def *def)
     p->def = *def;
     dem_pair_recompute(d, a, b);
     d->pair_set[(size_t)a * d->n_materials + b] = d->pair_set[(size_t)b * d->n_materials + a] = 1;
+    d->forces_valid = 0;
     dem_clear_error(d);
     return DEM_OK;
 }
@@ -197,6 +198,7 @@ dem_status dem_pair_set_effect(dem_domain *d, int a, int b, const char *effect, 
         for (int k = 0; k < DEM_MAX_EFFECT_PARAMS; k++) p->effects[slot].params[k] = k < n_params ? params[k] : 0.0;
     }
     d->pairs[(size_t)b * d->n_materials + a] = *p;
+    d->forces_valid = 0;
     dem_clear_error(d);
     return DEM_OK;
 }
