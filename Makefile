@@ -7,7 +7,7 @@
 CC      ?= gcc
 PREFIX  ?= /usr/local
 BUILD   := build
-OPT     ?= -O3 -fno-math-errno
+OPT     ?= -O3 -fno-math-errno -fno-trapping-math
 CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem
 LDLIBS  += -lm
 PYTHON  := .venv/bin/python

@@ -6,7 +6,14 @@
 #define DEM_CONTACT_LAW_H
 
 #include "internal.h"
+#include <float.h>
 #include <math.h>
+
+#if defined(__GNUC__)
+#define DEM_INLINE static inline __attribute__((always_inline))
+#else
+#define DEM_INLINE static inline
+#endif
 
 /* Geometry and kinematics of one contact, seen from particle i. */
 typedef struct contact_in {
@@ -27,26 +34,24 @@ typedef struct contact_out {
     double mr[3];     /* rolling torque on i (partner gets -mr) */
 } contact_out;
 
-static inline void vec_project_keep_length(double *h, const double *n)
+DEM_INLINE void vec_project_keep_length(double *h, const double *n)
 {
-    /* Rotate a history vector into the current tangent plane: project, restore length. */
-    double h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-    if (h2 == 0.0) return;
-    double hn = h[0] * n[0] + h[1] * n[1] + h[2] * n[2];
+    /* Rotate a history vector into the current tangent plane: project, restore length.
+     * Written without branches, exactly as the batch kernel in forces.c does it. */
+    const double h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+    const double hn = h[0] * n[0] + h[1] * n[1] + h[2] * n[2];
     h[0] -= hn * n[0];
     h[1] -= hn * n[1];
     h[2] -= hn * n[2];
-    double p2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-    if (p2 > 0.0) {
-        double s = sqrt(h2 / p2);
-        h[0] *= s;
-        h[1] *= s;
-        h[2] *= s;
-    }
+    const double p2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+    const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
+    h[0] *= s;
+    h[1] *= s;
+    h[2] *= s;
 }
 
 /* xi: tangential spring (3), mr_hist: rolling torque history (3), both updated in place. */
-static inline void contact_law(const pair_props *pp, const contact_in *c, double dt, double *xi,
+DEM_INLINE void contact_law(const pair_props *pp, const contact_in *c, double dt, double *xi,
                                double *mr_hist, contact_out *out)
 {
     const double *n = c->n;

@@ -59,6 +59,7 @@ dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
             double delta = d->radius[i] - (d->x[3 * i + pw->def.axis] - pw->def.position) * pw->def.side;
             if (delta <= 0.0) continue;
             out->contact_count++;
+            out->wall_contact_count++;
             out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], pw->def.material)->e_star, d->radius[i], delta);
             double ratio = delta / d->radius[i];
             if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;

@@ -98,6 +98,7 @@ static void free_pair_list(pair_list *p)
     free(p->image);
     free(p->xi);
     free(p->mr);
+    free(p->active);
 }
 
 static void free_wall_list(wall_list *w)
@@ -180,6 +181,7 @@ dem_status dem_domain_profile(const dem_domain *d, dem_profile *p)
 {
     if (!d || !p) return DEM_ERR_NULL;
     *p = d->profile;
+    p->neighbor_pairs = d->pairs_cur.count;
     return DEM_OK;
 }
 

@@ -25,6 +25,7 @@ typedef struct pair_props {
     double st_over_sn_sqrt;  /* sqrt(S_t / S_n) = sqrt(4 G* / E*) */
     int n_effects;
     pair_effect effects[DEM_MAX_EFFECTS_PER_PAIR];
+    int fast;                /* the vectorised kernel handles this pair (see forces.c) */
 } pair_props;
 
 typedef struct plane_wall {
@@ -42,6 +43,7 @@ typedef struct pair_list {
     uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
     double *xi;           /* 3 per entry */
     double *mr;           /* 3 per entry */
+    uint8_t *active;      /* entry touched last step: its force slots hold non-zero values */
 } pair_list;
 
 /* Wall contact candidates, grouped by particle (CSR over particles). */
@@ -119,6 +121,7 @@ void dem_clear_error(dem_domain *d);
 /* materials.c */
 const pair_props *dem_pair_props(const dem_domain *d, int a, int b);
 void dem_pair_recompute(dem_domain *d, int a, int b);
+void dem_pair_update_fast(pair_props *p);
 
 /* restitution.c: damping factor that delivers restitution e with a force clipped at zero */
 double dem_damping_factor_for_restitution(double e);
@@ -132,7 +135,30 @@ int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 /* forces.c: contact forces of the current state into f/t (row part) and the entries
  * (reaction part); dem_forces_gather adds the reactions of particle i. */
 dem_status dem_forces_compute(dem_domain *d, double dt_hist);
-void dem_forces_gather(const dem_domain *d, int64_t i, double *f, double *t);
+
+/* Adds the reactions stored on the list entries where i is the j partner, in entry order
+ * (the fixed order that makes results independent of the thread count). */
+static inline void dem_forces_gather(const dem_domain *d, int64_t i, double *f, double *t)
+{
+    const int64_t *te = d->trans_entry;
+    const double *pf = d->pair_force, *pt = d->pair_torque_j;
+    double f0 = f[0], f1 = f[1], f2 = f[2], t0 = t[0], t1 = t[1], t2 = t[2];
+    for (int64_t q = d->trans_start[i]; q < d->trans_start[i + 1]; q++) {
+        const int64_t k = te[q];
+        f0 += pf[3 * k];
+        f1 += pf[3 * k + 1];
+        f2 += pf[3 * k + 2];
+        t0 += pt[3 * k];
+        t1 += pt[3 * k + 1];
+        t2 += pt[3 * k + 2];
+    }
+    f[0] = f0;
+    f[1] = f1;
+    f[2] = f2;
+    t[0] = t0;
+    t[1] = t1;
+    t[2] = t2;
+}
 
 /* step.c */
 double dem_rayleigh_time(dem_domain *d);

@@ -35,7 +35,9 @@ static int pair_list_reserve(pair_list *pl, int64_t need)
     if (xi) pl->xi = xi;
     double *mr = dem_realloc_array(pl->mr, (size_t)c * 3, sizeof *mr);
     if (mr) pl->mr = mr;
-    if (!j || !im || !xi || !mr) return 0;
+    uint8_t *ac = dem_realloc_array(pl->active, (size_t)c, 1);
+    if (ac) pl->active = ac;
+    if (!j || !im || !xi || !mr || !ac) return 0;
     pl->capacity = c;
     return 1;
 }
@@ -297,8 +299,10 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (int64_t i = 0; i < n; i++) {
         scan_row(d, i, pl->j + start[i], pl->image + start[i]);
-        for (int64_t k = start[i]; k < start[i + 1]; k++)
+        for (int64_t k = start[i]; k < start[i + 1]; k++) {
             transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl->xi + 3 * k, pl->mr + 3 * k);
+            pl->active[k] = 1; /* force slots not yet written */
+        }
     }
 
     /* per-entry force scratch and the transposed list (entries where a particle is j) */

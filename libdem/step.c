@@ -88,6 +88,79 @@ static dem_status refresh_forces(dem_domain *d)
     return DEM_OK;
 }
 
+/* Outcome of a drift: largest squared displacement since the list build, first bad particles. */
+typedef struct moved {
+    double maxdisp2;
+    int64_t bad_nan, bad_out;
+} moved;
+
+/* Optionally gather the reactions and close the previous step (half kick), then open the
+ * next one: half kick, drift, displacement and sanity checks. */
+static moved kick_drift(dem_domain *d, int close_previous)
+{
+    const int64_t n = d->n;
+    const double dt = d->def.dt, half = 0.5 * dt, *g = d->def.gravity;
+    double *x = d->x, *v = d->v, *w = d->w, *f = d->f, *t = d->t;
+    const double *xb = d->x_build, *im = d->inv_mass, *ii = d->inv_inertia;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
+        hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
+    }
+    double maxdisp2 = 0.0;
+    int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
+    reduction(min : bad_nan, bad_out)
+    for (int64_t i = 0; i < n; i++) {
+        double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i, *fi = f + 3 * i, *ti = t + 3 * i;
+        const double imi = im[i], iii = ii[i];
+        if (close_previous) {
+            dem_forces_gather(d, i, fi, ti);
+            for (int a = 0; a < 3; a++) {
+                vi[a] += half * (fi[a] * imi + g[a]);
+                wi[a] += half * ti[a] * iii;
+            }
+        }
+        double disp2 = 0.0, sum = 0.0;
+        int in = 1;
+        for (int a = 0; a < 3; a++) {
+            vi[a] += half * (fi[a] * imi + g[a]);
+            wi[a] += half * ti[a] * iii;
+            xi[a] += dt * vi[a];
+            double u = xi[a] - xb[3 * i + a];
+            disp2 += u * u;
+            sum += xi[a] + wi[a];
+            in &= (xi[a] >= lo[a]) & (xi[a] <= hi[a]);
+        }
+        if (disp2 > maxdisp2) maxdisp2 = disp2;
+        if (!(sum - sum == 0.0)) { /* NaN or inf somewhere in x, v (through x) or w */
+            if (i < bad_nan) bad_nan = i;
+        } else if (!in && i < bad_out) {
+            bad_out = i;
+        }
+    }
+    moved m = {maxdisp2, bad_nan, bad_out};
+    return m;
+}
+
+/* Gather the reactions and close the step (half kick). */
+static void gather_kick(dem_domain *d)
+{
+    const int64_t n = d->n;
+    const double half = 0.5 * d->def.dt, *g = d->def.gravity;
+    double *v = d->v, *w = d->w, *f = d->f, *t = d->t;
+    const double *im = d->inv_mass, *ii = d->inv_inertia;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads)
+    for (int64_t i = 0; i < n; i++) {
+        double *fi = f + 3 * i, *ti = t + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
+        dem_forces_gather(d, i, fi, ti);
+        for (int a = 0; a < 3; a++) {
+            vi[a] += half * (fi[a] * im[i] + g[a]);
+            wi[a] += half * ti[a] * ii[i];
+        }
+    }
+}
+
 dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
 {
     if (!d) return DEM_ERR_NULL;
@@ -119,89 +192,50 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         if (s != DEM_OK) return s;
     }
 
-    const int nt = d->def.num_threads;
-    const double half = 0.5 * dt;
-    const double *g = d->def.gravity;
+    if (n_steps == 0) return result; /* forces of the current state are now valid */
     const double skin_half2 = 0.25 * d->def.skin * d->def.skin;
-    double lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
-        hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
-    }
-
+    /* velocity Verlet; the closing half kick of a step and the opening half kick + drift of
+     * the next run in one pass over the particles (same operations in the same order) */
     for (int64_t s = 0; s < n_steps; s++) {
-        const int64_t n = d->n;
-        double *x = d->x, *v = d->v, *w = d->w, *f = d->f, *t = d->t;
-        const double *xb = d->x_build, *im = d->inv_mass, *ii = d->inv_inertia;
         double t0 = now_s();
-        /* kick (half) + drift */
-        double maxdisp2 = 0.0;
-        int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
-#pragma omp parallel for schedule(static) num_threads(nt) reduction(max : maxdisp2) reduction(min : bad_nan, bad_out)
-        for (int64_t i = 0; i < n; i++) {
-            double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
-            const double *fi = f + 3 * i, *ti = t + 3 * i;
-            double disp2 = 0.0;
-            int ok = 1, in = 1;
-            for (int a = 0; a < 3; a++) {
-                vi[a] += half * (fi[a] * im[i] + g[a]);
-                wi[a] += half * ti[a] * ii[i];
-                xi[a] += dt * vi[a];
-                double u = xi[a] - xb[3 * i + a];
-                disp2 += u * u;
-                ok &= isfinite(xi[a]) && isfinite(vi[a]) && isfinite(wi[a]);
-                in &= xi[a] >= lo[a] && xi[a] <= hi[a];
-            }
-            if (disp2 > maxdisp2) maxdisp2 = disp2;
-            if (!ok && i < bad_nan) bad_nan = i;
-            if (ok && !in && i < bad_out) bad_out = i;
-        }
+        moved m = kick_drift(d, s > 0);
         double t1 = now_s();
         d->profile.integrate_s += t1 - t0;
-        if (bad_nan != INT64_MAX) {
+        if (s > 0) { /* the previous step ended inside kick_drift */
+            d->step++;
+            d->time += dt;
+            d->profile.steps++;
+        }
+        if (m.bad_nan != INT64_MAX) {
             d->forces_valid = 0;
             return dem_fail(d, DEM_ERR_NUMERICAL,
                             "step %lld: particle id %lld has a non-finite position or velocity (NaN/inf)",
-                            (long long)d->step, (long long)d->id[bad_nan]);
+                            (long long)d->step + 1, (long long)d->id[m.bad_nan]);
         }
-        if (bad_out != INT64_MAX) {
-            const double *p = x + 3 * bad_out;
+        if (m.bad_out != INT64_MAX) {
+            const double *p = d->x + 3 * m.bad_out;
             d->forces_valid = 0;
             return dem_fail(d, DEM_ERR_OUT_OF_BOUNDS, "step %lld: particle id %lld left the domain at (%g, %g, %g)",
-                            (long long)d->step, (long long)d->id[bad_out], p[0], p[1], p[2]);
+                            (long long)d->step + 1, (long long)d->id[m.bad_out], p[0], p[1], p[2]);
         }
-        if (maxdisp2 > skin_half2) {
+        if (m.maxdisp2 > skin_half2) {
             dem_status st = dem_neighbor_rebuild(d, NULL);
             if (st != DEM_OK) return st;
-            x = d->x;
-            v = d->v;
-            w = d->w;
-            f = d->f;
-            t = d->t;
         }
         double t2 = now_s();
         d->profile.neighbor_s += t2 - t1;
         dem_status st = dem_forces_compute(d, dt);
+        d->profile.contact_s += now_s() - t2;
         if (st != DEM_OK) {
             d->forces_valid = 0;
             return st;
         }
-        /* gather reactions + kick (half) */
-        const double *im2 = d->inv_mass, *ii2 = d->inv_inertia;
-#pragma omp parallel for schedule(static) num_threads(nt)
-        for (int64_t i = 0; i < n; i++) {
-            double *fi = f + 3 * i, *ti = t + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
-            dem_forces_gather(d, i, fi, ti);
-            for (int a = 0; a < 3; a++) {
-                vi[a] += half * (fi[a] * im2[i] + g[a]);
-                wi[a] += half * ti[a] * ii2[i];
-            }
-        }
-        double t3 = now_s();
-        d->profile.contact_s += t3 - t2;
-        d->step++;
-        d->time += dt;
-        d->profile.steps++;
     }
+    double t3 = now_s();
+    gather_kick(d);
+    d->profile.integrate_s += now_s() - t3;
+    d->step++;
+    d->time += dt;
+    d->profile.steps++;
     return result;
 }

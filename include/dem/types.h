@@ -64,6 +64,7 @@ typedef struct dem_diagnostics {
     double time;                 /* s */
     int64_t particle_count;
     int64_t contact_count;       /* particle–particle + particle–wall contacts with overlap > 0 */
+    int64_t wall_contact_count;  /* of which particle–wall */
     double kinetic_energy;       /* J, translational + rotational */
     double elastic_energy;       /* J, normal Hertz potential (8/15) E* sqrt(R*) d^(5/2) in the contacts */
     double max_overlap_ratio;    /* max overlap / smaller radius */
@@ -77,6 +78,7 @@ typedef struct dem_profile {
     double integrate_s;    /* velocity Verlet kicks and drift, checks */
     int64_t steps;
     int64_t neighbor_builds;
+    int64_t neighbor_pairs;  /* entries of the current (half) Verlet list */
 } dem_profile;
 
 /* Time-step estimates for the current particles and materials. */
