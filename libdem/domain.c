@@ -94,11 +94,13 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
 static void free_pair_list(pair_list *p)
 {
     free(p->start);
+    free(p->row);
     free(p->j);
     free(p->image);
-    free(p->xi);
-    free(p->mr);
-    free(p->active);
+    for (int a = 0; a < 3; a++) {
+        free(p->xi[a]);
+        free(p->mr[a]);
+    }
 }
 
 static void free_wall_list(wall_list *w)
@@ -116,7 +118,7 @@ void dem_domain_destroy(dem_domain *d)
     free(d->materials);
     free(d->pairs);
     free(d->pair_set);
-    double *dbl[] = {d->x, d->v, d->w, d->f, d->t, d->x_build, d->radius, d->inv_mass, d->inv_inertia, d->scratch};
+    double *dbl[] = {d->x, d->v, d->w, d->f, d->t, d->x_build, d->radius, d->inv_mass, d->inv_inertia};
     for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++) free(dbl[k]);
     free(d->mat);
     free(d->id);
@@ -126,8 +128,11 @@ void dem_domain_destroy(dem_domain *d)
     free_pair_list(&d->pairs_old);
     free_wall_list(&d->walls_cur);
     free_wall_list(&d->walls_old);
-    free(d->pair_force);
-    free(d->pair_torque_j);
+    for (int a = 0; a < 3; a++) {
+        free(d->pf[a]);
+        free(d->pti[a]);
+        free(d->ptj[a]);
+    }
     free(d->trans_start);
     free(d->trans_entry);
     free(d->cell_of);
@@ -223,15 +228,16 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     if (!d) return 0;
     size_t b = sizeof *d;
     size_t cap = (size_t)d->cap;
-    b += cap * (3 * 7 + 3 + 3) * sizeof(double); /* x v w f t x_build scratch(3), radius inv_mass inv_inertia */
+    b += cap * (6 * 3 + 3) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia */
     b += cap * (sizeof(int32_t) * 3 + sizeof(dem_particle_id) + sizeof(int64_t)); /* mat cell_of perm id trans_start */
+    b += (size_t)(d->walls_cur.start ? 2 * (cap + 1) * sizeof(int64_t) : 0);     /* wall list offsets */
     b += (size_t)d->cap_ids * sizeof(int32_t);
     b += (size_t)d->cap_cells * sizeof(int64_t) + (size_t)d->cap_cursor * sizeof(int64_t);
     const pair_list *pls[2] = {&d->pairs_cur, &d->pairs_old};
     for (int k = 0; k < 2; k++)
-        b += (size_t)pls[k]->capacity * (sizeof(int32_t) + 1 + 6 * sizeof(double)) +
+        b += (size_t)pls[k]->capacity * (2 * sizeof(int32_t) + 1 + 6 * sizeof(double)) +
              (size_t)(pls[k]->n_rows + 1) * sizeof(int64_t);
-    b += (size_t)d->trans_capacity * (6 * sizeof(double) + sizeof(int64_t));
+    b += (size_t)d->trans_capacity * (9 * sizeof(double) + sizeof(int32_t));
     const wall_list *wls[2] = {&d->walls_cur, &d->walls_old};
     for (int k = 0; k < 2; k++) b += (size_t)wls[k]->capacity * (sizeof(int32_t) + 9 * sizeof(double));
     b += (size_t)d->n_materials * d->n_materials * (sizeof(pair_props) + 1);

@@ -33,17 +33,18 @@ typedef struct plane_wall {
     double normal[3];
 } plane_wall;
 
-/* Verlet neighbour list, half (j in row i has a larger index), CSR. Per entry: the
- * partner, the periodic image code, tangential spring xi and rolling torque history. */
+/* Verlet neighbour list, half (each pair once), CSR by row particle. Per entry: the row
+ * particle i and partner j, the periodic image code of j, and the contact histories as
+ * structure of arrays (the pair kernel reads and writes them with contiguous vectors). */
 typedef struct pair_list {
     int64_t n_rows;       /* particles covered */
     int64_t count, capacity;
     int64_t *start;       /* n_rows + 1 */
+    int32_t *row;         /* i */
     int32_t *j;
     uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
-    double *xi;           /* 3 per entry */
-    double *mr;           /* 3 per entry */
-    uint8_t *active;      /* entry touched last step: its force slots hold non-zero values */
+    double *xi[3];        /* tangential spring */
+    double *mr[3];        /* rolling torque */
 } pair_list;
 
 /* Wall contact candidates, grouped by particle (CSR over particles). */
@@ -84,10 +85,10 @@ struct dem_domain {
     /* neighbour search */
     pair_list pairs_cur, pairs_old;
     wall_list walls_cur, walls_old;
-    double *pair_force;       /* 3 per pair entry: force on j (= -force on i) */
-    double *pair_torque_j;    /* 3 per pair entry: torque on j */
+    double *pf[3];            /* per pair entry: force on i (j gets -pf) */
+    double *pti[3], *ptj[3];  /* per pair entry: torque on i, on j */
     int64_t *trans_start;     /* n + 1: entries where particle is the j partner */
-    int64_t *trans_entry;
+    int32_t *trans_entry;
     int64_t trans_capacity;
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
@@ -95,7 +96,6 @@ struct dem_domain {
     int32_t *perm;            /* new index -> old index (rebuild scratch) */
     int64_t *cursor;          /* rebuild scratch for counting sorts */
     int64_t cap_cursor;
-    double *scratch;          /* rebuild scratch, 3 cap */
     int ncell[3];
     double cell_size[3];
     int need_rebuild;
@@ -132,25 +132,37 @@ double dem_restitution_for_damping_factor(double factor);
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask);
 int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 
-/* forces.c: contact forces of the current state into f/t (row part) and the entries
- * (reaction part); dem_forces_gather adds the reactions of particle i. */
+/* forces.c: pair contact forces of the current state into the per-entry slots (pf, pti,
+ * ptj); dem_forces_gather sums a particle's slots, dem_wall_contacts adds its plane walls.
+ * dt_hist advances the spring histories (0 for a refresh without motion). *bad receives the
+ * smallest row index with a runaway overlap (INT64_MAX if none). */
 dem_status dem_forces_compute(dem_domain *d, double dt_hist);
+void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
+dem_status dem_report_runaway(dem_domain *d, int64_t i);
 
-/* Adds the reactions stored on the list entries where i is the j partner, in entry order
- * (the fixed order that makes results independent of the thread count). */
+/* Sum of particle i's pair slots: its own row, then the entries where it is the partner, in
+ * entry order (the fixed order that makes results independent of the thread count). */
 static inline void dem_forces_gather(const dem_domain *d, int64_t i, double *f, double *t)
 {
-    const int64_t *te = d->trans_entry;
-    const double *pf = d->pair_force, *pt = d->pair_torque_j;
-    double f0 = f[0], f1 = f[1], f2 = f[2], t0 = t[0], t1 = t[1], t2 = t[2];
+    double f0 = 0.0, f1 = 0.0, f2 = 0.0, t0 = 0.0, t1 = 0.0, t2 = 0.0;
+    const double *pf0 = d->pf[0], *pf1 = d->pf[1], *pf2 = d->pf[2];
+    for (int64_t k = d->pairs_cur.start[i]; k < d->pairs_cur.start[i + 1]; k++) {
+        f0 += pf0[k];
+        f1 += pf1[k];
+        f2 += pf2[k];
+        t0 += d->pti[0][k];
+        t1 += d->pti[1][k];
+        t2 += d->pti[2][k];
+    }
+    const int32_t *te = d->trans_entry;
     for (int64_t q = d->trans_start[i]; q < d->trans_start[i + 1]; q++) {
         const int64_t k = te[q];
-        f0 += pf[3 * k];
-        f1 += pf[3 * k + 1];
-        f2 += pf[3 * k + 2];
-        t0 += pt[3 * k];
-        t1 += pt[3 * k + 1];
-        t2 += pt[3 * k + 2];
+        f0 -= pf0[k];
+        f1 -= pf1[k];
+        f2 -= pf2[k];
+        t0 += d->ptj[0][k];
+        t1 += d->ptj[1][k];
+        t2 += d->ptj[2][k];
     }
     f[0] = f0;
     f[1] = f1;

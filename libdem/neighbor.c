@@ -21,23 +21,35 @@ static int grow(void **p, int64_t *cap, int64_t need, size_t elem)
     return 1;
 }
 
+/* Realloc every array of `arrays` to `count` elements of `elem` bytes; 0 if any failed
+ * (the ones that succeeded stay valid). */
+static int realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem)
+{
+    int ok = 1;
+    for (int a = 0; a < n_arrays; a++) {
+        void *q = dem_realloc_array(*arrays[a], count, elem);
+        if (q) *arrays[a] = q;
+        else ok = 0;
+    }
+    return ok;
+}
+
+/* Capacity for `need` entries with a 10 % margin (a settling bed's list grows by little at a
+ * time; doubling would waste up to half the memory). */
+static int64_t margin(int64_t need) { return need + need / 10 + 256; }
+
 /* Grow a pair list's per-entry arrays to hold `need` entries. */
 static int pair_list_reserve(pair_list *pl, int64_t need)
 {
     if (need <= pl->capacity) return 1;
-    int64_t c = pl->capacity > 0 ? pl->capacity : 256;
-    while (c < need) c *= 2;
-    int32_t *j = dem_realloc_array(pl->j, (size_t)c, sizeof *j);
-    if (j) pl->j = j;
-    uint8_t *im = dem_realloc_array(pl->image, (size_t)c, 1);
-    if (im) pl->image = im;
-    double *xi = dem_realloc_array(pl->xi, (size_t)c * 3, sizeof *xi);
-    if (xi) pl->xi = xi;
-    double *mr = dem_realloc_array(pl->mr, (size_t)c * 3, sizeof *mr);
-    if (mr) pl->mr = mr;
-    uint8_t *ac = dem_realloc_array(pl->active, (size_t)c, 1);
-    if (ac) pl->active = ac;
-    if (!j || !im || !xi || !mr || !ac) return 0;
+    int64_t c = margin(need);
+    void **i32[] = {(void **)&pl->row, (void **)&pl->j};
+    void **u8[] = {(void **)&pl->image};
+    void **hist[] = {(void **)&pl->xi[0], (void **)&pl->xi[1], (void **)&pl->xi[2],
+                     (void **)&pl->mr[0], (void **)&pl->mr[1], (void **)&pl->mr[2]};
+    if (!realloc_all(i32, 2, (size_t)c, sizeof(int32_t)) || !realloc_all(u8, 1, (size_t)c, 1) ||
+        !realloc_all(hist, 6, (size_t)c, sizeof(double)))
+        return 0;
     pl->capacity = c;
     return 1;
 }
@@ -174,26 +186,25 @@ static int64_t scan_row(const dem_domain *d, int64_t i, int32_t *out_j, uint8_t 
     return count;
 }
 
-/* Copy the history of pair (old oa, old ob) into xi/mr, or zero them when new. */
-static void transfer_pair_history(const pair_list *old, int64_t old_rows, int32_t oa, int32_t ob, double *xi,
-                                  double *mr)
+/* Copy the history of pair (old oa, old ob) into entry k of the new list, or zero it. */
+static void transfer_pair_history(const pair_list *old, int64_t old_rows, int32_t oa, int32_t ob, pair_list *pl,
+                                  int64_t k)
 {
     for (int pass = 0; pass < 2; pass++) {
         int32_t r = pass ? ob : oa, want = pass ? oa : ob;
         if (r < 0 || r >= old_rows) continue;
-        for (int64_t k = old->start[r]; k < old->start[r + 1]; k++) {
-            if (old->j[k] == want) {
+        for (int64_t q = old->start[r]; q < old->start[r + 1]; q++) {
+            if (old->j[q] == want) {
                 double sgn = pass ? -1.0 : 1.0; /* the history is seen from the row particle */
                 for (int a = 0; a < 3; a++) {
-                    xi[a] = sgn * old->xi[3 * k + a];
-                    mr[a] = sgn * old->mr[3 * k + a];
+                    pl->xi[a][k] = sgn * old->xi[a][q];
+                    pl->mr[a][k] = sgn * old->mr[a][q];
                 }
                 return;
             }
         }
     }
-    xi[0] = xi[1] = xi[2] = 0.0;
-    mr[0] = mr[1] = mr[2] = 0.0;
+    for (int a = 0; a < 3; a++) pl->xi[a][k] = pl->mr[a][k] = 0.0;
 }
 
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
@@ -252,7 +263,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
         if (d->cell_of[i] >= 0) d->perm[cursor[d->cell_of[i]]++] = (int32_t)i;
 
     /* reorder particle arrays */
-    void *scr = d->scratch;
+    void *scr = d->f; /* the forces are recomputed after every build: their array is free */
+    d->forces_valid = 0;
     permute(d->x, d->perm, n, 3 * sizeof(double), scr);
     permute(d->v, d->perm, n, 3 * sizeof(double), scr);
     permute(d->w, d->perm, n, 3 * sizeof(double), scr);
@@ -300,29 +312,27 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n; i++) {
         scan_row(d, i, pl->j + start[i], pl->image + start[i]);
         for (int64_t k = start[i]; k < start[i + 1]; k++) {
-            transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl->xi + 3 * k, pl->mr + 3 * k);
-            pl->active[k] = 1; /* force slots not yet written */
+            pl->row[k] = (int32_t)i;
+            transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl, k);
         }
     }
 
     /* per-entry force scratch and the transposed list (entries where a particle is j) */
     if (count > d->trans_capacity) {
-        int64_t c = d->trans_capacity > 0 ? d->trans_capacity : 256;
-        while (c < count) c *= 2;
-        double *pf = dem_realloc_array(d->pair_force, (size_t)c * 3, sizeof *pf);
-        if (pf) d->pair_force = pf;
-        double *pt = dem_realloc_array(d->pair_torque_j, (size_t)c * 3, sizeof *pt);
-        if (pt) d->pair_torque_j = pt;
-        int64_t *te = dem_realloc_array(d->trans_entry, (size_t)c, sizeof *te);
-        if (te) d->trans_entry = te;
-        if (!pf || !pt || !te) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+        int64_t c = margin(count);
+        void **slots[] = {(void **)&d->pf[0],  (void **)&d->pf[1],  (void **)&d->pf[2],
+                          (void **)&d->pti[0], (void **)&d->pti[1], (void **)&d->pti[2],
+                          (void **)&d->ptj[0], (void **)&d->ptj[1], (void **)&d->ptj[2]};
+        void **te[] = {(void **)&d->trans_entry};
+        if (!realloc_all(slots, 9, (size_t)c, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
+            return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
     }
     memset(d->trans_start, 0, (size_t)(n + 1) * sizeof *d->trans_start);
     for (int64_t k = 0; k < count; k++) d->trans_start[pl->j[k] + 1]++;
     for (int64_t i = 0; i < n; i++) d->trans_start[i + 1] += d->trans_start[i];
     memcpy(cursor, d->trans_start, (size_t)(n + 1) * sizeof *cursor);
-    for (int64_t k = 0; k < count; k++) d->trans_entry[cursor[pl->j[k]]++] = k; /* entry order */
+    for (int64_t k = 0; k < count; k++) d->trans_entry[cursor[pl->j[k]]++] = (int32_t)k; /* entry order */
 
     /* wall candidates, grouped by particle */
     wall_list *wl = &d->walls_cur;

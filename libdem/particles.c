@@ -10,7 +10,7 @@ static int reserve_particles(dem_domain *d, int64_t need)
     if (need <= d->cap) return 1;
     int64_t c = d->cap > 0 ? d->cap : 1024;
     while (c < need) c *= 2;
-    double **vec3[] = {&d->x, &d->v, &d->w, &d->f, &d->t, &d->x_build, &d->scratch};
+    double **vec3[] = {&d->x, &d->v, &d->w, &d->f, &d->t, &d->x_build};
     for (size_t k = 0; k < sizeof vec3 / sizeof vec3[0]; k++) {
         double *p = dem_realloc_array(*vec3[k], (size_t)c * 3, sizeof(double));
         if (!p) return 0;

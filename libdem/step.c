@@ -82,8 +82,13 @@ static dem_status refresh_forces(dem_domain *d)
     dem_status s = dem_forces_compute(d, 0.0);
     if (s != DEM_OK) return s;
     const int64_t n = d->n;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads)
-    for (int64_t i = 0; i < n; i++) dem_forces_gather(d, i, d->f + 3 * i, d->t + 3 * i);
+    int64_t bad = INT64_MAX;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(min : bad)
+    for (int64_t i = 0; i < n; i++) {
+        dem_forces_gather(d, i, d->f + 3 * i, d->t + 3 * i);
+        dem_wall_contacts(d, i, 0.0, d->f + 3 * i, d->t + 3 * i, &bad);
+    }
+    if (bad != INT64_MAX) return dem_report_runaway(d, bad);
     d->forces_valid = 1;
     return DEM_OK;
 }
@@ -91,11 +96,11 @@ static dem_status refresh_forces(dem_domain *d)
 /* Outcome of a drift: largest squared displacement since the list build, first bad particles. */
 typedef struct moved {
     double maxdisp2;
-    int64_t bad_nan, bad_out;
+    int64_t bad_nan, bad_out, bad_overlap;
 } moved;
 
-/* Optionally gather the reactions and close the previous step (half kick), then open the
- * next one: half kick, drift, displacement and sanity checks. */
+/* Optionally gather the contact forces (pair slots + walls) and close the previous step (half
+ * kick), then open the next one: half kick, drift, displacement and sanity checks. */
 static moved kick_drift(dem_domain *d, int close_previous)
 {
     const int64_t n = d->n;
@@ -108,14 +113,15 @@ static moved kick_drift(dem_domain *d, int close_previous)
         hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
     }
     double maxdisp2 = 0.0;
-    int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
+    int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_overlap = INT64_MAX;
 #pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
-    reduction(min : bad_nan, bad_out)
+    reduction(min : bad_nan, bad_out, bad_overlap)
     for (int64_t i = 0; i < n; i++) {
         double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i, *fi = f + 3 * i, *ti = t + 3 * i;
         const double imi = im[i], iii = ii[i];
         if (close_previous) {
             dem_forces_gather(d, i, fi, ti);
+            dem_wall_contacts(d, i, dt, fi, ti, &bad_overlap);
             for (int a = 0; a < 3; a++) {
                 vi[a] += half * (fi[a] * imi + g[a]);
                 wi[a] += half * ti[a] * iii;
@@ -139,26 +145,29 @@ static moved kick_drift(dem_domain *d, int close_previous)
             bad_out = i;
         }
     }
-    moved m = {maxdisp2, bad_nan, bad_out};
+    moved m = {maxdisp2, bad_nan, bad_out, bad_overlap};
     return m;
 }
 
-/* Gather the reactions and close the step (half kick). */
-static void gather_kick(dem_domain *d)
+/* Gather the contact forces and close the step (half kick); returns a runaway row or INT64_MAX. */
+static int64_t gather_kick(dem_domain *d)
 {
     const int64_t n = d->n;
     const double half = 0.5 * d->def.dt, *g = d->def.gravity;
     double *v = d->v, *w = d->w, *f = d->f, *t = d->t;
     const double *im = d->inv_mass, *ii = d->inv_inertia;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads)
+    int64_t bad = INT64_MAX;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(min : bad)
     for (int64_t i = 0; i < n; i++) {
         double *fi = f + 3 * i, *ti = t + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
         dem_forces_gather(d, i, fi, ti);
+        dem_wall_contacts(d, i, d->def.dt, fi, ti, &bad);
         for (int a = 0; a < 3; a++) {
             vi[a] += half * (fi[a] * im[i] + g[a]);
             wi[a] += half * ti[a] * ii[i];
         }
     }
+    return bad;
 }
 
 dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
@@ -202,6 +211,10 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         double t1 = now_s();
         d->profile.integrate_s += t1 - t0;
         if (s > 0) { /* the previous step ended inside kick_drift */
+            if (m.bad_overlap != INT64_MAX) {
+                d->forces_valid = 0;
+                return dem_report_runaway(d, m.bad_overlap);
+            }
             d->step++;
             d->time += dt;
             d->profile.steps++;
@@ -232,10 +245,15 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         }
     }
     double t3 = now_s();
-    gather_kick(d);
+    int64_t bad = gather_kick(d);
     d->profile.integrate_s += now_s() - t3;
+    if (bad != INT64_MAX) {
+        d->forces_valid = 0;
+        return dem_report_runaway(d, bad);
+    }
     d->step++;
     d->time += dt;
     d->profile.steps++;
+    d->forces_valid = 1; /* the next call continues exactly where this one stopped */
     return result;
 }

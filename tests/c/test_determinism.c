@@ -1,9 +1,10 @@
 /* Results are bitwise identical for any thread count (fixed-order force reduction):
  * a settling polydisperse bed with walls, friction and EPSD2 rolling resistance, and a
- * periodic variant, run with 1, 2 and 3 threads, must give the same state hash. */
+ * periodic variant, run with 1, 2 and 3 threads, must give the same state hash; so must
+ * one long step call and the same steps split into several calls. */
 #include "test_util.h"
 
-static uint64_t run_bed(int threads, int periodic_x)
+static uint64_t run_bed(int threads, int periodic_x, int chunks)
 {
     dem_domain_def def = dem_default_domain_def();
     def.lo[0] = def.lo[1] = def.lo[2] = 0;
@@ -46,7 +47,7 @@ static uint64_t run_bed(int threads, int periodic_x)
     assert_ok(dem_particles_add(d, N, pos, rad, mats, vel, NULL, NULL));
     uint64_t h0, h;
     assert_ok(dem_domain_state_hash(d, &h0));
-    assert_ok(dem_domain_step(d, 3000));
+    for (int c = 0; c < chunks; c++) assert_ok(dem_domain_step(d, 3000 / chunks));
     assert_ok(dem_domain_state_hash(d, &h));
     assert_true(h != h0);
     dem_profile prof;
@@ -59,17 +60,18 @@ static uint64_t run_bed(int threads, int periodic_x)
 static void test_threads_walls(void **st)
 {
     (void)st;
-    uint64_t h1 = run_bed(1, 0), h2 = run_bed(2, 0), h3 = run_bed(3, 0);
+    uint64_t h1 = run_bed(1, 0, 1), h2 = run_bed(2, 0, 1), h3 = run_bed(3, 0, 1);
     assert_true(h1 == h2);
     assert_true(h1 == h3);
+    assert_true(h1 == run_bed(2, 0, 3)); /* 3 x 1000 steps == 3000 steps */
 }
 
 static void test_threads_periodic(void **st)
 {
     (void)st;
-    uint64_t h1 = run_bed(1, 1), h2 = run_bed(2, 1);
+    uint64_t h1 = run_bed(1, 1, 1), h2 = run_bed(2, 1, 1);
     assert_true(h1 == h2);
-    assert_true(h1 != run_bed(1, 0)); /* the hash does see a different run */
+    assert_true(h1 != run_bed(1, 0, 1)); /* the hash does see a different run */
 }
 
 int main(void)
