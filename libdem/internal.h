@@ -146,23 +146,27 @@ static inline void dem_forces_gather(const dem_domain *d, int64_t i, double *f, 
 {
     double f0 = 0.0, f1 = 0.0, f2 = 0.0, t0 = 0.0, t1 = 0.0, t2 = 0.0;
     const double *pf0 = d->pf[0], *pf1 = d->pf[1], *pf2 = d->pf[2];
-    for (int64_t k = d->pairs_cur.start[i]; k < d->pairs_cur.start[i + 1]; k++) {
+    const double *pti0 = d->pti[0], *pti1 = d->pti[1], *pti2 = d->pti[2];
+    const double *ptj0 = d->ptj[0], *ptj1 = d->ptj[1], *ptj2 = d->ptj[2];
+    const int64_t k0 = d->pairs_cur.start[i], k1 = d->pairs_cur.start[i + 1];
+    for (int64_t k = k0; k < k1; k++) {
         f0 += pf0[k];
         f1 += pf1[k];
         f2 += pf2[k];
-        t0 += d->pti[0][k];
-        t1 += d->pti[1][k];
-        t2 += d->pti[2][k];
+        t0 += pti0[k];
+        t1 += pti1[k];
+        t2 += pti2[k];
     }
     const int32_t *te = d->trans_entry;
-    for (int64_t q = d->trans_start[i]; q < d->trans_start[i + 1]; q++) {
+    const int64_t q0 = d->trans_start[i], q1 = d->trans_start[i + 1];
+    for (int64_t q = q0; q < q1; q++) {
         const int64_t k = te[q];
         f0 -= pf0[k];
         f1 -= pf1[k];
         f2 -= pf2[k];
-        t0 += d->ptj[0][k];
-        t1 += d->ptj[1][k];
-        t2 += d->ptj[2][k];
+        t0 += ptj0[k];
+        t1 += ptj1[k];
+        t2 += ptj2[k];
     }
     f[0] = f0;
     f[1] = f1;

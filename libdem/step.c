@@ -112,6 +112,7 @@ static moved kick_drift(dem_domain *d, int close_previous)
         lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
         hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
     }
+    const int has_walls = d->n_walls > 0;
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_overlap = INT64_MAX;
 #pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
@@ -119,23 +120,33 @@ static moved kick_drift(dem_domain *d, int close_previous)
     for (int64_t i = 0; i < n; i++) {
         double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i, *fi = f + 3 * i, *ti = t + 3 * i;
         const double imi = im[i], iii = ii[i];
+        double fl[3], tl[3], vl[3] = {vi[0], vi[1], vi[2]}, wl[3] = {wi[0], wi[1], wi[2]};
         if (close_previous) {
-            dem_forces_gather(d, i, fi, ti);
-            dem_wall_contacts(d, i, dt, fi, ti, &bad_overlap);
+            dem_forces_gather(d, i, fl, tl);
+            if (has_walls) dem_wall_contacts(d, i, dt, fl, tl, &bad_overlap);
             for (int a = 0; a < 3; a++) {
-                vi[a] += half * (fi[a] * imi + g[a]);
-                wi[a] += half * ti[a] * iii;
+                fi[a] = fl[a];
+                ti[a] = tl[a];
+                vl[a] += half * (fl[a] * imi + g[a]);
+                wl[a] += half * tl[a] * iii;
+            }
+        } else {
+            for (int a = 0; a < 3; a++) {
+                fl[a] = fi[a];
+                tl[a] = ti[a];
             }
         }
         double disp2 = 0.0, sum = 0.0;
         int in = 1;
         for (int a = 0; a < 3; a++) {
-            vi[a] += half * (fi[a] * imi + g[a]);
-            wi[a] += half * ti[a] * iii;
-            xi[a] += dt * vi[a];
+            vl[a] += half * (fl[a] * imi + g[a]);
+            wl[a] += half * tl[a] * iii;
+            vi[a] = vl[a];
+            wi[a] = wl[a];
+            xi[a] += dt * vl[a];
             double u = xi[a] - xb[3 * i + a];
             disp2 += u * u;
-            sum += xi[a] + wi[a];
+            sum += xi[a] + wl[a];
             in &= (xi[a] >= lo[a]) & (xi[a] <= hi[a]);
         }
         if (disp2 > maxdisp2) maxdisp2 = disp2;
