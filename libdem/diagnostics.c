@@ -4,11 +4,6 @@
 #include <math.h>
 #include <string.h>
 
-static const double image_sign[27][3] = {
-    {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {-1, 0, -1}, {0, 0, -1}, {1, 0, -1}, {-1, 1, -1}, {0, 1, -1}, {1, 1, -1},
-    {-1, -1, 0},  {0, -1, 0},  {1, -1, 0},  {-1, 0, 0},  {0, 0, 0},  {1, 0, 0},  {-1, 1, 0},  {0, 1, 0},  {1, 1, 0},
-    {-1, -1, 1},  {0, -1, 1},  {1, -1, 1},  {-1, 0, 1},  {0, 0, 1},  {1, 0, 1},  {-1, 1, 1},  {0, 1, 1},  {1, 1, 1}};
-
 /* Hertz elastic energy stored at overlap delta: integral of (4/3) E* sqrt(R*) d^(3/2). */
 static double hertz_energy(double e_star, double r_eff, double delta)
 {
@@ -42,7 +37,7 @@ dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
             double r2 = 0.0;
             for (int a = 0; a < 3; a++) {
                 double u = d->x[3 * i + a] - d->x[3 * j + a] -
-                           image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]);
+                           dem_image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]);
                 r2 += u * u;
             }
             double delta = d->radius[i] + d->radius[j] - sqrt(r2);

@@ -94,7 +94,7 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
 static void free_pair_list(pair_list *p)
 {
     free(p->start);
-    free(p->row);
+    free(p->active);
     free(p->j);
     free(p->image);
     for (int a = 0; a < 3; a++) {
@@ -130,12 +130,13 @@ void dem_domain_destroy(dem_domain *d)
     free_wall_list(&d->walls_old);
     for (int a = 0; a < 3; a++) {
         free(d->pf[a]);
-        free(d->pti[a]);
         free(d->ptj[a]);
     }
     free(d->trans_start);
     free(d->trans_entry);
     free(d->cell_of);
+    free(d->trans_lo);
+    free(d->trans_hi);
     free(d->cell_start);
     free(d->perm);
     free(d->cursor);
@@ -229,15 +230,15 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     size_t b = sizeof *d;
     size_t cap = (size_t)d->cap;
     b += cap * (6 * 3 + 3) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia */
-    b += cap * (sizeof(int32_t) * 3 + sizeof(dem_particle_id) + sizeof(int64_t)); /* mat cell_of perm id trans_start */
+    b += cap * (sizeof(int32_t) * 5 + sizeof(dem_particle_id) + sizeof(int64_t)); /* mat cell_of perm trans_lo/hi id trans_start */
     b += (size_t)(d->walls_cur.start ? 2 * (cap + 1) * sizeof(int64_t) : 0);     /* wall list offsets */
     b += (size_t)d->cap_ids * sizeof(int32_t);
     b += (size_t)d->cap_cells * sizeof(int64_t) + (size_t)d->cap_cursor * sizeof(int64_t);
     const pair_list *pls[2] = {&d->pairs_cur, &d->pairs_old};
     for (int k = 0; k < 2; k++)
-        b += (size_t)pls[k]->capacity * (2 * sizeof(int32_t) + 1 + 6 * sizeof(double)) +
+        b += (size_t)pls[k]->capacity * (sizeof(int32_t) + 2 + 6 * sizeof(double)) +
              (size_t)(pls[k]->n_rows + 1) * sizeof(int64_t);
-    b += (size_t)d->trans_capacity * (9 * sizeof(double) + sizeof(int32_t));
+    b += (size_t)d->trans_capacity * (6 * sizeof(double) + sizeof(int32_t));
     const wall_list *wls[2] = {&d->walls_cur, &d->walls_old};
     for (int k = 0; k < 2; k++) b += (size_t)wls[k]->capacity * (sizeof(int32_t) + 9 * sizeof(double));
     b += (size_t)d->n_materials * d->n_materials * (sizeof(pair_props) + 1);

@@ -25,7 +25,6 @@ typedef struct pair_props {
     double st_over_sn_sqrt;  /* sqrt(S_t / S_n) = sqrt(4 G* / E*) */
     int n_effects;
     pair_effect effects[DEM_MAX_EFFECTS_PER_PAIR];
-    int fast;                /* the vectorised kernel handles this pair (see forces.c) */
 } pair_props;
 
 typedef struct plane_wall {
@@ -33,16 +32,16 @@ typedef struct plane_wall {
     double normal[3];
 } plane_wall;
 
-/* Verlet neighbour list, half (each pair once), CSR by row particle. Per entry: the row
- * particle i and partner j, the periodic image code of j, and the contact histories as
- * structure of arrays (the pair kernel reads and writes them with contiguous vectors). */
+/* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the
+ * partner j, the periodic image code of j, the contact histories, and whether the pair
+ * touched at the last evaluation (its reaction slot then holds non-zero values). */
 typedef struct pair_list {
     int64_t n_rows;       /* particles covered */
     int64_t count, capacity;
     int64_t *start;       /* n_rows + 1 */
-    int32_t *row;         /* i */
     int32_t *j;
     uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
+    uint8_t *active;
     double *xi[3];        /* tangential spring */
     double *mr[3];        /* rolling torque */
 } pair_list;
@@ -85,10 +84,11 @@ struct dem_domain {
     /* neighbour search */
     pair_list pairs_cur, pairs_old;
     wall_list walls_cur, walls_old;
-    double *pf[3];            /* per pair entry: force on i (j gets -pf) */
-    double *pti[3], *ptj[3];  /* per pair entry: torque on i, on j */
-    int64_t *trans_start;     /* n + 1: entries where particle is the j partner */
+    double *pf[3];            /* per pair entry: contact force on i (the partner gets -pf) */
+    double *ptj[3];           /* per pair entry: torque on the partner */
+    int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
+    int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
     int64_t trans_capacity;
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
@@ -121,7 +121,6 @@ void dem_clear_error(dem_domain *d);
 /* materials.c */
 const pair_props *dem_pair_props(const dem_domain *d, int a, int b);
 void dem_pair_recompute(dem_domain *d, int a, int b);
-void dem_pair_update_fast(pair_props *p);
 
 /* restitution.c: damping factor that delivers restitution e with a force clipped at zero */
 double dem_damping_factor_for_restitution(double e);
@@ -129,52 +128,15 @@ double dem_damping_factor_for_restitution(double e);
 double dem_restitution_for_damping_factor(double factor);
 
 /* neighbor.c */
+extern const double dem_image_sign[27][3]; /* periodic image code -> shift in box lengths */
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask);
 int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 
-/* forces.c: pair contact forces of the current state into the per-entry slots (pf, pti,
- * ptj); dem_forces_gather sums a particle's slots, dem_wall_contacts adds its plane walls.
- * dt_hist advances the spring histories (0 for a refresh without motion). *bad receives the
- * smallest row index with a runaway overlap (INT64_MAX if none). */
-dem_status dem_forces_compute(dem_domain *d, double dt_hist);
+/* forces.c: plane-wall contacts of particle i added to f/t (*bad: i if an overlap runs
+ * away, min), and the messages for a runaway overlap at pair entry k / at particle i. */
 void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
-dem_status dem_report_runaway(dem_domain *d, int64_t i);
-
-/* Sum of particle i's pair slots: its own row, then the entries where it is the partner, in
- * entry order (the fixed order that makes results independent of the thread count). */
-static inline void dem_forces_gather(const dem_domain *d, int64_t i, double *f, double *t)
-{
-    double f0 = 0.0, f1 = 0.0, f2 = 0.0, t0 = 0.0, t1 = 0.0, t2 = 0.0;
-    const double *pf0 = d->pf[0], *pf1 = d->pf[1], *pf2 = d->pf[2];
-    const double *pti0 = d->pti[0], *pti1 = d->pti[1], *pti2 = d->pti[2];
-    const double *ptj0 = d->ptj[0], *ptj1 = d->ptj[1], *ptj2 = d->ptj[2];
-    const int64_t k0 = d->pairs_cur.start[i], k1 = d->pairs_cur.start[i + 1];
-    for (int64_t k = k0; k < k1; k++) {
-        f0 += pf0[k];
-        f1 += pf1[k];
-        f2 += pf2[k];
-        t0 += pti0[k];
-        t1 += pti1[k];
-        t2 += pti2[k];
-    }
-    const int32_t *te = d->trans_entry;
-    const int64_t q0 = d->trans_start[i], q1 = d->trans_start[i + 1];
-    for (int64_t q = q0; q < q1; q++) {
-        const int64_t k = te[q];
-        f0 -= pf0[k];
-        f1 -= pf1[k];
-        f2 -= pf2[k];
-        t0 += ptj0[k];
-        t1 += ptj1[k];
-        t2 += ptj2[k];
-    }
-    f[0] = f0;
-    f[1] = f1;
-    f[2] = f2;
-    t[0] = t0;
-    t[1] = t1;
-    t[2] = t2;
-}
+dem_status dem_report_runaway_pair(dem_domain *d, int64_t k);
+dem_status dem_report_runaway_wall(dem_domain *d, int64_t i);
 
 /* step.c */
 double dem_rayleigh_time(dem_domain *d);

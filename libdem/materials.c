@@ -24,16 +24,6 @@ dem_pair_def dem_default_pair_def(void)
     return p;
 }
 
-/* The vectorised pair kernel covers the spring rolling models without dashpot and no effects;
- * other pairs take the general contact_law path. */
-void dem_pair_update_fast(pair_props *p)
-{
-    const dem_pair_def *q = &p->def;
-    p->fast = p->n_effects == 0 &&
-              (q->rolling_friction == 0.0 || q->rolling_model == DEM_ROLLING_EPSD2 ||
-               (q->rolling_model == DEM_ROLLING_EPSD && q->rolling_damping == 0.0));
-}
-
 const pair_props *dem_pair_props(const dem_domain *d, int a, int b)
 {
     return &d->pairs[(size_t)a * d->n_materials + b];
@@ -50,7 +40,6 @@ void dem_pair_recompute(dem_domain *d, int a, int b)
                        2 * (2 - mb->poisson_ratio) * (1 + mb->poisson_ratio) / mb->youngs_modulus);
     p->damping_factor = dem_damping_factor_for_restitution(p->def.restitution);
     p->st_over_sn_sqrt = sqrt(4.0 * p->g_star / p->e_star);
-    dem_pair_update_fast(p);
     d->pairs[(size_t)b * d->n_materials + a] = *p;
 }
 
@@ -208,7 +197,6 @@ dem_status dem_pair_set_effect(dem_domain *d, int a, int b, const char *effect, 
         p->effects[slot].effect = idx;
         for (int k = 0; k < DEM_MAX_EFFECT_PARAMS; k++) p->effects[slot].params[k] = k < n_params ? params[k] : 0.0;
     }
-    dem_pair_update_fast(p);
     d->pairs[(size_t)b * d->n_materials + a] = *p;
     d->forces_valid = 0;
     dem_clear_error(d);

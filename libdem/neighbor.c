@@ -9,6 +9,12 @@
 
 #define IMAGE_NONE 13
 
+/* Periodic image code -> shift of the partner in box lengths: code = (sx+1) + 3(sy+1) + 9(sz+1). */
+const double dem_image_sign[27][3] = {
+    {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {-1, 0, -1}, {0, 0, -1}, {1, 0, -1}, {-1, 1, -1}, {0, 1, -1}, {1, 1, -1},
+    {-1, -1, 0},  {0, -1, 0},  {1, -1, 0},  {-1, 0, 0},  {0, 0, 0},  {1, 0, 0},  {-1, 1, 0},  {0, 1, 0},  {1, 1, 0},
+    {-1, -1, 1},  {0, -1, 1},  {1, -1, 1},  {-1, 0, 1},  {0, 0, 1},  {1, 0, 1},  {-1, 1, 1},  {0, 1, 1},  {1, 1, 1}};
+
 static int grow(void **p, int64_t *cap, int64_t need, size_t elem)
 {
     if (need <= *cap) return 1;
@@ -43,11 +49,11 @@ static int pair_list_reserve(pair_list *pl, int64_t need)
 {
     if (need <= pl->capacity) return 1;
     int64_t c = margin(need);
-    void **i32[] = {(void **)&pl->row, (void **)&pl->j};
-    void **u8[] = {(void **)&pl->image};
+    void **i32[] = {(void **)&pl->j};
+    void **u8[] = {(void **)&pl->image, (void **)&pl->active};
     void **hist[] = {(void **)&pl->xi[0], (void **)&pl->xi[1], (void **)&pl->xi[2],
                      (void **)&pl->mr[0], (void **)&pl->mr[1], (void **)&pl->mr[2]};
-    if (!realloc_all(i32, 2, (size_t)c, sizeof(int32_t)) || !realloc_all(u8, 1, (size_t)c, 1) ||
+    if (!realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !realloc_all(u8, 2, (size_t)c, 1) ||
         !realloc_all(hist, 6, (size_t)c, sizeof(double)))
         return 0;
     pl->capacity = c;
@@ -312,8 +318,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n; i++) {
         scan_row(d, i, pl->j + start[i], pl->image + start[i]);
         for (int64_t k = start[i]; k < start[i + 1]; k++) {
-            pl->row[k] = (int32_t)i;
             transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl, k);
+            pl->active[k] = 1; /* reaction slot not yet written */
         }
     }
 
@@ -321,10 +327,9 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     if (count > d->trans_capacity) {
         int64_t c = margin(count);
         void **slots[] = {(void **)&d->pf[0],  (void **)&d->pf[1],  (void **)&d->pf[2],
-                          (void **)&d->pti[0], (void **)&d->pti[1], (void **)&d->pti[2],
                           (void **)&d->ptj[0], (void **)&d->ptj[1], (void **)&d->ptj[2]};
         void **te[] = {(void **)&d->trans_entry};
-        if (!realloc_all(slots, 9, (size_t)c, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
+        if (!realloc_all(slots, 6, (size_t)c, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
             return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
     }
@@ -333,6 +338,16 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n; i++) d->trans_start[i + 1] += d->trans_start[i];
     memcpy(cursor, d->trans_start, (size_t)(n + 1) * sizeof *cursor);
     for (int64_t k = 0; k < count; k++) d->trans_entry[cursor[pl->j[k]]++] = (int32_t)k; /* entry order */
+    for (int64_t i = 0; i < n; i++) {
+        d->trans_lo[i] = INT32_MAX;
+        d->trans_hi[i] = -1;
+    }
+    for (int64_t i = 0; i < n; i++) /* which rows name each particle: the sweep's finishing order */
+        for (int64_t k = start[i]; k < start[i + 1]; k++) {
+            int32_t j = pl->j[k];
+            if (i < d->trans_lo[j]) d->trans_lo[j] = (int32_t)i;
+            if (i > d->trans_hi[j]) d->trans_hi[j] = (int32_t)i;
+        }
 
     /* wall candidates, grouped by particle */
     wall_list *wl = &d->walls_cur;

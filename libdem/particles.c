@@ -22,7 +22,7 @@ static int reserve_particles(dem_domain *d, int64_t need)
         if (!p) return 0;
         *sc[k] = p;
     }
-    int32_t **i32[] = {&d->mat, &d->cell_of, &d->perm};
+    int32_t **i32[] = {&d->mat, &d->cell_of, &d->perm, &d->trans_lo, &d->trans_hi};
     for (size_t k = 0; k < sizeof i32 / sizeof i32[0]; k++) {
         int32_t *p = dem_realloc_array(*i32[k], (size_t)c, sizeof(int32_t));
         if (!p) return 0;

@@ -2,7 +2,7 @@
  * a particle has moved half the skin, failure detection that names the particle, and the
  * time-step checks (Rayleigh time). */
 #define _POSIX_C_SOURCE 200809L
-#include "internal.h"
+#include "sweep.h"
 #include <float.h>
 #include <math.h>
 #include <time.h>
@@ -72,113 +72,47 @@ dem_status dem_domain_timestep_info(dem_domain *d, dem_timestep_info *info)
 }
 
 /* Make f/t complete for the current state (after insertion, removal, velocity changes):
- * forces with no spring increment, then the reactions gathered. */
+ * forces with no spring increment. */
 static dem_status refresh_forces(dem_domain *d)
 {
     if (d->need_rebuild) {
         dem_status s = dem_neighbor_rebuild(d, NULL);
         if (s != DEM_OK) return s;
     }
-    dem_status s = dem_forces_compute(d, 0.0);
-    if (s != DEM_OK) return s;
-    const int64_t n = d->n;
-    int64_t bad = INT64_MAX;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(min : bad)
-    for (int64_t i = 0; i < n; i++) {
-        dem_forces_gather(d, i, d->f + 3 * i, d->t + 3 * i);
-        dem_wall_contacts(d, i, 0.0, d->f + 3 * i, d->t + 3 * i, &bad);
-    }
-    if (bad != INT64_MAX) return dem_report_runaway(d, bad);
+    sweep_result r = dem_sweep(d, 0.0, SWEEP_FORCES);
+    if (r.bad_pair != INT64_MAX) return dem_report_runaway_pair(d, r.bad_pair);
+    if (r.bad_wall != INT64_MAX) return dem_report_runaway_wall(d, r.bad_wall);
     d->forces_valid = 1;
     return DEM_OK;
 }
 
-/* Outcome of a drift: largest squared displacement since the list build, first bad particles. */
-typedef struct moved {
-    double maxdisp2;
-    int64_t bad_nan, bad_out, bad_overlap;
-} moved;
-
-/* Optionally gather the contact forces (pair slots + walls) and close the previous step (half
- * kick), then open the next one: half kick, drift, displacement and sanity checks. */
-static moved kick_drift(dem_domain *d, int close_previous)
+/* The opening half kick and drift of the first step of a call (later steps open inside the
+ * sweep that closes the previous one). */
+static sweep_result open_first_step(dem_domain *d)
 {
-    const int64_t n = d->n;
-    const double dt = d->def.dt, half = 0.5 * dt, *g = d->def.gravity;
-    double *x = d->x, *v = d->v, *w = d->w, *f = d->f, *t = d->t;
-    const double *xb = d->x_build, *im = d->inv_mass, *ii = d->inv_inertia;
     double lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
-        hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
-    }
-    const int has_walls = d->n_walls > 0;
-    double maxdisp2 = 0.0;
-    int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_overlap = INT64_MAX;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
-    reduction(min : bad_nan, bad_out, bad_overlap)
-    for (int64_t i = 0; i < n; i++) {
-        double *xi = x + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i, *fi = f + 3 * i, *ti = t + 3 * i;
-        const double imi = im[i], iii = ii[i];
-        double fl[3], tl[3], vl[3] = {vi[0], vi[1], vi[2]}, wl[3] = {wi[0], wi[1], wi[2]};
-        if (close_previous) {
-            dem_forces_gather(d, i, fl, tl);
-            if (has_walls) dem_wall_contacts(d, i, dt, fl, tl, &bad_overlap);
-            for (int a = 0; a < 3; a++) {
-                fi[a] = fl[a];
-                ti[a] = tl[a];
-                vl[a] += half * (fl[a] * imi + g[a]);
-                wl[a] += half * tl[a] * iii;
-            }
-        } else {
-            for (int a = 0; a < 3; a++) {
-                fl[a] = fi[a];
-                tl[a] = ti[a];
-            }
-        }
-        double disp2 = 0.0, sum = 0.0;
-        int in = 1;
-        for (int a = 0; a < 3; a++) {
-            vl[a] += half * (fl[a] * imi + g[a]);
-            wl[a] += half * tl[a] * iii;
-            vi[a] = vl[a];
-            wi[a] = wl[a];
-            xi[a] += dt * vl[a];
-            double u = xi[a] - xb[3 * i + a];
-            disp2 += u * u;
-            sum += xi[a] + wl[a];
-            in &= (xi[a] >= lo[a]) & (xi[a] <= hi[a]);
-        }
-        if (disp2 > maxdisp2) maxdisp2 = disp2;
-        if (!(sum - sum == 0.0)) { /* NaN or inf somewhere in x, v (through x) or w */
-            if (i < bad_nan) bad_nan = i;
-        } else if (!in && i < bad_out) {
-            bad_out = i;
-        }
-    }
-    moved m = {maxdisp2, bad_nan, bad_out, bad_overlap};
-    return m;
-}
-
-/* Gather the contact forces and close the step (half kick); returns a runaway row or INT64_MAX. */
-static int64_t gather_kick(dem_domain *d)
-{
+    dem_sweep_bounds(d, lo, hi);
     const int64_t n = d->n;
-    const double half = 0.5 * d->def.dt, *g = d->def.gravity;
-    double *v = d->v, *w = d->w, *f = d->f, *t = d->t;
-    const double *im = d->inv_mass, *ii = d->inv_inertia;
-    int64_t bad = INT64_MAX;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(min : bad)
+    double maxdisp2 = 0.0;
+    int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
+#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
+    reduction(min : bad_nan, bad_out)
     for (int64_t i = 0; i < n; i++) {
-        double *fi = f + 3 * i, *ti = t + 3 * i, *vi = v + 3 * i, *wi = w + 3 * i;
-        dem_forces_gather(d, i, fi, ti);
-        dem_wall_contacts(d, i, d->def.dt, fi, ti, &bad);
+        sweep_result res;
+        dem_sweep_result_init(&res);
+        double *v = d->v + 3 * i, *w = d->w + 3 * i;
+        double vl[3] = {v[0], v[1], v[2]}, wl[3] = {w[0], w[1], w[2]};
+        dem_open_step(d, i, d->f + 3 * i, d->t + 3 * i, vl, wl, lo, hi, &res);
         for (int a = 0; a < 3; a++) {
-            vi[a] += half * (fi[a] * im[i] + g[a]);
-            wi[a] += half * ti[a] * ii[i];
+            v[a] = vl[a];
+            w[a] = wl[a];
         }
+        if (res.maxdisp2 > maxdisp2) maxdisp2 = res.maxdisp2;
+        if (res.bad_nan < bad_nan) bad_nan = res.bad_nan;
+        if (res.bad_out < bad_out) bad_out = res.bad_out;
     }
-    return bad;
+    sweep_result m = {maxdisp2, bad_nan, bad_out, INT64_MAX, INT64_MAX};
+    return m;
 }
 
 dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
@@ -211,25 +145,13 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         d->profile.neighbor_s += now_s() - t0;
         if (s != DEM_OK) return s;
     }
-
     if (n_steps == 0) return result; /* forces of the current state are now valid */
+
     const double skin_half2 = 0.25 * d->def.skin * d->def.skin;
-    /* velocity Verlet; the closing half kick of a step and the opening half kick + drift of
-     * the next run in one pass over the particles (same operations in the same order) */
+    double t0 = now_s();
+    sweep_result m = open_first_step(d);
+    d->profile.integrate_s += now_s() - t0;
     for (int64_t s = 0; s < n_steps; s++) {
-        double t0 = now_s();
-        moved m = kick_drift(d, s > 0);
-        double t1 = now_s();
-        d->profile.integrate_s += t1 - t0;
-        if (s > 0) { /* the previous step ended inside kick_drift */
-            if (m.bad_overlap != INT64_MAX) {
-                d->forces_valid = 0;
-                return dem_report_runaway(d, m.bad_overlap);
-            }
-            d->step++;
-            d->time += dt;
-            d->profile.steps++;
-        }
         if (m.bad_nan != INT64_MAX) {
             d->forces_valid = 0;
             return dem_fail(d, DEM_ERR_NUMERICAL,
@@ -242,29 +164,25 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
             return dem_fail(d, DEM_ERR_OUT_OF_BOUNDS, "step %lld: particle id %lld left the domain at (%g, %g, %g)",
                             (long long)d->step + 1, (long long)d->id[m.bad_out], p[0], p[1], p[2]);
         }
+        double t1 = now_s();
         if (m.maxdisp2 > skin_half2) {
             dem_status st = dem_neighbor_rebuild(d, NULL);
             if (st != DEM_OK) return st;
         }
         double t2 = now_s();
         d->profile.neighbor_s += t2 - t1;
-        dem_status st = dem_forces_compute(d, dt);
+        /* forces, closing half kick and (but for the last step) the next opening half kick + drift */
+        m = dem_sweep(d, dt, s + 1 < n_steps ? SWEEP_CLOSE_OPEN : SWEEP_CLOSE);
         d->profile.contact_s += now_s() - t2;
-        if (st != DEM_OK) {
+        if (m.bad_pair != INT64_MAX || m.bad_wall != INT64_MAX) {
             d->forces_valid = 0;
-            return st;
+            return m.bad_pair != INT64_MAX ? dem_report_runaway_pair(d, m.bad_pair)
+                                           : dem_report_runaway_wall(d, m.bad_wall);
         }
+        d->step++;
+        d->time += dt;
+        d->profile.steps++;
     }
-    double t3 = now_s();
-    int64_t bad = gather_kick(d);
-    d->profile.integrate_s += now_s() - t3;
-    if (bad != INT64_MAX) {
-        d->forces_valid = 0;
-        return dem_report_runaway(d, bad);
-    }
-    d->step++;
-    d->time += dt;
-    d->profile.steps++;
     d->forces_valid = 1; /* the next call continues exactly where this one stopped */
     return result;
 }

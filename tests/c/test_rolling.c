@@ -13,7 +13,7 @@ static const double R = 1e-3, G = 9.81, MU = 0.5, DT = 2e-6;
 
 typedef struct rig { dem_domain *d; int mat; } rig;
 
-static rig make_rig(double mu_r)
+static rig make_rig_model(double mu_r, dem_rolling_model model)
 {
     rig r;
     dem_domain_def def = dem_default_domain_def();
@@ -29,7 +29,7 @@ static rig make_rig(double mu_r)
     dem_pair_def p = dem_default_pair_def();
     p.friction = MU;
     p.rolling_friction = mu_r;
-    p.rolling_model = DEM_ROLLING_EPSD2;
+    p.rolling_model = model;
     assert_ok(dem_pair_set(r.d, r.mat, r.mat, &p));
     dem_plane_wall_def w = dem_default_plane_wall_def();
     w.material = r.mat;
@@ -43,6 +43,8 @@ static rig make_rig(double mu_r)
     assert_ok(dem_domain_step(r.d, 10000));
     return r;
 }
+
+static rig make_rig(double mu_r) { return make_rig_model(mu_r, DEM_ROLLING_EPSD2); }
 
 static void state(dem_domain *d, double *x, double *v, double *w)
 {
@@ -96,27 +98,49 @@ static double slope(const double *t, const double *v, int n)
     return (n * stv - st * sv) / (n * stt - st * st);
 }
 
-static void test_rolling_resistance(void **st)
+/* Launch at 0.5 m/s; deceleration fitted over the middle 80 % of the rolling phase. Returns
+ * the rig (at 90 % of the rolling phase) for more checks. */
+static rig measure_rolling_deceleration(dem_rolling_model model, double mu_r, double *decel)
 {
-    (void)st;
-    const double v0 = 0.5, mu_r = 0.1;
-    rig r = make_rig(mu_r);
+    const double v0 = 0.5;
+    rig r = make_rig_model(mu_r, model);
     launch_until_rolling(r.d, v0);
-    double x[3], v[3], w[3], ts[100], vs[100];
-    int n = 0;
+    double x[3], v[3], w[3], ts[80], vs[80];
     state(r.d, x, v, w);
     double t_stop = v[0] / (5.0 / 7.0 * mu_r * G);
-    /* sample the middle 80 % of the rolling phase */
     assert_ok(dem_domain_step(r.d, (int64_t)(0.1 * t_stop / DT)));
-    for (n = 0; n < 80; n++) {
+    for (int n = 0; n < 80; n++) {
         assert_ok(dem_domain_step(r.d, (int64_t)(0.01 * t_stop / DT)));
         state(r.d, x, v, w);
         ts[n] = n * 0.01 * t_stop;
         vs[n] = v[0];
     }
-    assert_close(-slope(ts, vs, n), 5.0 / 7.0 * mu_r * G, 0.02, 0);
-    /* run past the stop, then it must stay put */
-    assert_ok(dem_domain_step(r.d, (int64_t)(0.2 * t_stop / DT)));
+    *decel = -slope(ts, vs, 80);
+    return r;
+}
+
+/* Every rolling model resists with the same limiting torque mu_r R* F_n while rolling. */
+static void test_rolling_models(void **st)
+{
+    (void)st;
+    const dem_rolling_model models[3] = {DEM_ROLLING_CDT, DEM_ROLLING_EPSD, DEM_ROLLING_EPSD2};
+    for (int m = 0; m < 3; m++) {
+        double decel;
+        rig r = measure_rolling_deceleration(models[m], 0.1, &decel);
+        assert_close(decel, 5.0 / 7.0 * 0.1 * G, 0.02, 0);
+        dem_domain_destroy(r.d);
+    }
+}
+
+static void test_rolling_resistance(void **st)
+{
+    (void)st;
+    const double v0 = 0.5, mu_r = 0.1;
+    double decel, x[3], v[3], w[3];
+    rig r = measure_rolling_deceleration(DEM_ROLLING_EPSD2, mu_r, &decel);
+    assert_close(decel, 5.0 / 7.0 * mu_r * G, 0.02, 0);
+    /* run past the stop (0.1 s covers the last 10 % of the rolling phase), then it must stay put */
+    assert_ok(dem_domain_step(r.d, 50000));
     state(r.d, x, v, w);
     double x_stop = x[0];
     assert_true(fabs(v[0]) < 1e-3 * v0);
@@ -169,6 +193,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_slide_to_roll),
         cmocka_unit_test(test_rolling_resistance),
+        cmocka_unit_test(test_rolling_models),
         cmocka_unit_test(test_incline),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
