@@ -97,10 +97,7 @@ static void free_pair_list(pair_list *p)
     free(p->active);
     free(p->j);
     free(p->image);
-    for (int a = 0; a < 3; a++) {
-        free(p->xi[a]);
-        free(p->mr[a]);
-    }
+    free(p->hist);
 }
 
 static void free_wall_list(wall_list *w)
@@ -128,10 +125,7 @@ void dem_domain_destroy(dem_domain *d)
     free_pair_list(&d->pairs_old);
     free_wall_list(&d->walls_cur);
     free_wall_list(&d->walls_old);
-    for (int a = 0; a < 3; a++) {
-        free(d->pf[a]);
-        free(d->ptj[a]);
-    }
+    free(d->slot);
     free(d->trans_start);
     free(d->trans_entry);
     free(d->cell_of);

@@ -42,8 +42,7 @@ typedef struct pair_list {
     int32_t *j;
     uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
     uint8_t *active;
-    double *xi[3];        /* tangential spring */
-    double *mr[3];        /* rolling torque */
+    double *hist;         /* 6 per entry: tangential spring xi (3), rolling torque (3) */
 } pair_list;
 
 /* Wall contact candidates, grouped by particle (CSR over particles). */
@@ -84,8 +83,8 @@ struct dem_domain {
     /* neighbour search */
     pair_list pairs_cur, pairs_old;
     wall_list walls_cur, walls_old;
-    double *pf[3];            /* per pair entry: contact force on i (the partner gets -pf) */
-    double *ptj[3];           /* per pair entry: torque on the partner */
+    double *slot;             /* 6 per pair entry: contact force on i (the partner gets minus
+                               * it), torque on the partner; written while the pair touches */
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */

@@ -51,10 +51,9 @@ static int pair_list_reserve(pair_list *pl, int64_t need)
     int64_t c = margin(need);
     void **i32[] = {(void **)&pl->j};
     void **u8[] = {(void **)&pl->image, (void **)&pl->active};
-    void **hist[] = {(void **)&pl->xi[0], (void **)&pl->xi[1], (void **)&pl->xi[2],
-                     (void **)&pl->mr[0], (void **)&pl->mr[1], (void **)&pl->mr[2]};
+    void **hist[] = {(void **)&pl->hist};
     if (!realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !realloc_all(u8, 2, (size_t)c, 1) ||
-        !realloc_all(hist, 6, (size_t)c, sizeof(double)))
+        !realloc_all(hist, 1, (size_t)c * 6, sizeof(double)))
         return 0;
     pl->capacity = c;
     return 1;
@@ -202,15 +201,12 @@ static void transfer_pair_history(const pair_list *old, int64_t old_rows, int32_
         for (int64_t q = old->start[r]; q < old->start[r + 1]; q++) {
             if (old->j[q] == want) {
                 double sgn = pass ? -1.0 : 1.0; /* the history is seen from the row particle */
-                for (int a = 0; a < 3; a++) {
-                    pl->xi[a][k] = sgn * old->xi[a][q];
-                    pl->mr[a][k] = sgn * old->mr[a][q];
-                }
+                for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = sgn * old->hist[6 * q + a];
                 return;
             }
         }
     }
-    for (int a = 0; a < 3; a++) pl->xi[a][k] = pl->mr[a][k] = 0.0;
+    for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = 0.0;
 }
 
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
@@ -326,10 +322,9 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     /* per-entry force scratch and the transposed list (entries where a particle is j) */
     if (count > d->trans_capacity) {
         int64_t c = margin(count);
-        void **slots[] = {(void **)&d->pf[0],  (void **)&d->pf[1],  (void **)&d->pf[2],
-                          (void **)&d->ptj[0], (void **)&d->ptj[1], (void **)&d->ptj[2]};
+        void **slots[] = {(void **)&d->slot};
         void **te[] = {(void **)&d->trans_entry};
-        if (!realloc_all(slots, 6, (size_t)c, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
+        if (!realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
             return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
     }

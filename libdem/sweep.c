@@ -47,7 +47,7 @@ static inline void row_forces(const sweep_ctx *c, int64_t i, double *f, double *
         const double r2 = dx * dx + dy * dy + dz * dz;
         if (r2 >= rsum * rsum) {
             if (pl->active[k]) { /* contact ended: forget the springs, clear the slot once */
-                for (int a = 0; a < 3; a++) pl->xi[a][k] = pl->mr[a][k] = d->pf[a][k] = d->ptj[a][k] = 0.0;
+                for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = d->slot[6 * k + a] = 0.0;
                 pl->active[k] = 0;
             }
             continue;
@@ -75,15 +75,12 @@ static inline void row_forces(const sweep_ctx *c, int64_t i, double *f, double *
         in.radius_j = rj;
         in.inv_mass_i = imi;
         in.inv_mass_j = im[j];
-        double hx[3] = {pl->xi[0][k], pl->xi[1][k], pl->xi[2][k]};
-        double hm[3] = {pl->mr[0][k], pl->mr[1][k], pl->mr[2][k]};
+        double *h = pl->hist + 6 * k, *sl = d->slot + 6 * k;
         contact_out o;
-        contact_law(&row_pairs[d->mat[j]], &in, c->dt_hist, hx, hm, &o);
+        contact_law(&row_pairs[d->mat[j]], &in, c->dt_hist, h, h + 3, &o);
         for (int a = 0; a < 3; a++) {
-            pl->xi[a][k] = hx[a];
-            pl->mr[a][k] = hm[a];
-            d->pf[a][k] = o.force[a];
-            d->ptj[a][k] = -cj * o.cross[a] - o.mr[a];
+            sl[a] = o.force[a];
+            sl[3 + a] = -cj * o.cross[a] - o.mr[a];
         }
         pl->active[k] = 1;
         f0 += o.force[0];
@@ -108,13 +105,13 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
     dem_domain *d = c->d;
     const int32_t *te = d->trans_entry;
     for (int64_t q = d->trans_start[p]; q < d->trans_start[p + 1]; q++) {
-        const int64_t k = te[q];
-        f[0] -= d->pf[0][k];
-        f[1] -= d->pf[1][k];
-        f[2] -= d->pf[2][k];
-        t[0] += d->ptj[0][k];
-        t[1] += d->ptj[1][k];
-        t[2] += d->ptj[2][k];
+        const double *sl = d->slot + 6 * (int64_t)te[q];
+        f[0] -= sl[0];
+        f[1] -= sl[1];
+        f[2] -= sl[2];
+        t[0] += sl[3];
+        t[1] += sl[4];
+        t[2] += sl[5];
     }
     if (d->walls_cur.start[p] < d->walls_cur.start[p + 1]) dem_wall_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
     double *fp = d->f + 3 * p, *tp = d->t + 3 * p;
