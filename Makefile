@@ -20,7 +20,7 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib setup test test-c test-py bench demo install clean
+.PHONY: all lib setup test test-c test-py bench demo install clean FORCE
 
 all: lib
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
@@ -36,10 +36,12 @@ $(BUILD)/libdem.a: $(LIB_OBJ)
 $(BUILD)/libdem.so: $(LIB_OBJ)
 	$(CC) -shared -fopenmp -o $@ $^ $(LDLIBS)
 
-$(BUILD)/dem.pc: Makefile
+# pkg-config file for PREFIX (rewritten whenever PREFIX differs from the last one)
+$(BUILD)/dem.pc: FORCE
 	@mkdir -p $(BUILD)
-	printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nCflags: -I$${includedir}\n' \
-	  "$(PREFIX)" "$$(sed -n 's/#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)" > $@
+	@printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nCflags: -I$${includedir}\n' \
+	  "$(PREFIX)" "$$(sed -n 's/#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)" > $@.tmp
+	@cmp -s $@.tmp $@ || mv $@.tmp $@; rm -f $@.tmp
 
 setup:
 	@sh scripts/setup.sh

@@ -164,6 +164,9 @@ int dem_effect_find(const char *name);
 
 /* small helpers */
 void *dem_realloc_array(void *p, size_t count, size_t elem);
+/* Realloc every array to count elements of elem bytes; 0 if any failed (those that
+ * succeeded stay valid and grown). */
+int dem_realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem);
 int dem_is_finite(double x);
 
 #endif

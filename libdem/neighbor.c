@@ -27,19 +27,6 @@ static int grow(void **p, int64_t *cap, int64_t need, size_t elem)
     return 1;
 }
 
-/* Realloc every array of `arrays` to `count` elements of `elem` bytes; 0 if any failed
- * (the ones that succeeded stay valid). */
-static int realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem)
-{
-    int ok = 1;
-    for (int a = 0; a < n_arrays; a++) {
-        void *q = dem_realloc_array(*arrays[a], count, elem);
-        if (q) *arrays[a] = q;
-        else ok = 0;
-    }
-    return ok;
-}
-
 /* Capacity for `need` entries with a 10 % margin (a settling bed's list grows by little at a
  * time; doubling would waste up to half the memory). */
 static int64_t margin(int64_t need) { return need + need / 10 + 256; }
@@ -52,8 +39,8 @@ static int pair_list_reserve(pair_list *pl, int64_t need)
     void **i32[] = {(void **)&pl->j};
     void **u8[] = {(void **)&pl->image, (void **)&pl->active};
     void **hist[] = {(void **)&pl->hist};
-    if (!realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !realloc_all(u8, 2, (size_t)c, 1) ||
-        !realloc_all(hist, 1, (size_t)c * 6, sizeof(double)))
+    if (!dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(u8, 2, (size_t)c, 1) ||
+        !dem_realloc_all(hist, 1, (size_t)c * 6, sizeof(double)))
         return 0;
     pl->capacity = c;
     return 1;
@@ -62,17 +49,11 @@ static int pair_list_reserve(pair_list *pl, int64_t need)
 static int wall_list_reserve(wall_list *wl, int64_t need)
 {
     if (need <= wl->capacity) return 1;
-    int64_t c = wl->capacity > 0 ? wl->capacity : 64;
-    while (c < need) c *= 2;
-    int32_t *w = dem_realloc_array(wl->wall, (size_t)c, sizeof *w);
-    if (w) wl->wall = w;
-    double *xi = dem_realloc_array(wl->xi, (size_t)c * 3, sizeof *xi);
-    if (xi) wl->xi = xi;
-    double *mr = dem_realloc_array(wl->mr, (size_t)c * 3, sizeof *mr);
-    if (mr) wl->mr = mr;
-    double *f = dem_realloc_array(wl->force, (size_t)c * 3, sizeof *f);
-    if (f) wl->force = f;
-    if (!w || !xi || !mr || !f) return 0;
+    int64_t c = margin(need);
+    void **i32[] = {(void **)&wl->wall};
+    void **vec3[] = {(void **)&wl->xi, (void **)&wl->mr, (void **)&wl->force};
+    if (!dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(vec3, 3, (size_t)c * 3, sizeof(double)))
+        return 0;
     wl->capacity = c;
     return 1;
 }
@@ -324,7 +305,7 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
         int64_t c = margin(count);
         void **slots[] = {(void **)&d->slot};
         void **te[] = {(void **)&d->trans_entry};
-        if (!realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) || !realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
+        if (!dem_realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
             return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
     }

@@ -10,30 +10,14 @@ static int reserve_particles(dem_domain *d, int64_t need)
     if (need <= d->cap) return 1;
     int64_t c = d->cap > 0 ? d->cap : 1024;
     while (c < need) c *= 2;
-    double **vec3[] = {&d->x, &d->v, &d->w, &d->f, &d->t, &d->x_build};
-    for (size_t k = 0; k < sizeof vec3 / sizeof vec3[0]; k++) {
-        double *p = dem_realloc_array(*vec3[k], (size_t)c * 3, sizeof(double));
-        if (!p) return 0;
-        *vec3[k] = p;
-    }
-    double **sc[] = {&d->radius, &d->inv_mass, &d->inv_inertia};
-    for (size_t k = 0; k < sizeof sc / sizeof sc[0]; k++) {
-        double *p = dem_realloc_array(*sc[k], (size_t)c, sizeof(double));
-        if (!p) return 0;
-        *sc[k] = p;
-    }
-    int32_t **i32[] = {&d->mat, &d->cell_of, &d->perm, &d->trans_lo, &d->trans_hi};
-    for (size_t k = 0; k < sizeof i32 / sizeof i32[0]; k++) {
-        int32_t *p = dem_realloc_array(*i32[k], (size_t)c, sizeof(int32_t));
-        if (!p) return 0;
-        *i32[k] = p;
-    }
-    dem_particle_id *id = dem_realloc_array(d->id, (size_t)c, sizeof *id);
-    if (!id) return 0;
-    d->id = id;
-    int64_t *ts = dem_realloc_array(d->trans_start, (size_t)c + 1, sizeof *ts);
-    if (!ts) return 0;
-    d->trans_start = ts;
+    void **vec3[] = {(void **)&d->x, (void **)&d->v, (void **)&d->w, (void **)&d->f, (void **)&d->t, (void **)&d->x_build};
+    void **scalar[] = {(void **)&d->radius, (void **)&d->inv_mass, (void **)&d->inv_inertia};
+    void **i32[] = {(void **)&d->mat, (void **)&d->cell_of, (void **)&d->perm, (void **)&d->trans_lo,
+                    (void **)&d->trans_hi};
+    void **i64[] = {(void **)&d->id, (void **)&d->trans_start};
+    if (!dem_realloc_all(vec3, 6, (size_t)c * 3, sizeof(double)) || !dem_realloc_all(scalar, 3, (size_t)c, sizeof(double)) ||
+        !dem_realloc_all(i32, 5, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(i64, 2, (size_t)c + 1, sizeof(int64_t)))
+        return 0;
     d->cap = c;
     return 1;
 }

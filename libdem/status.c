@@ -57,4 +57,15 @@ void *dem_realloc_array(void *p, size_t count, size_t elem)
     return realloc(p, count * elem);
 }
 
+int dem_realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem)
+{
+    int ok = 1;
+    for (int a = 0; a < n_arrays; a++) {
+        void *q = dem_realloc_array(*arrays[a], count, elem);
+        if (q) *arrays[a] = q;
+        else ok = 0;
+    }
+    return ok;
+}
+
 int dem_is_finite(double x) { return isfinite(x) ? 1 : 0; }

@@ -74,8 +74,9 @@ typedef struct dem_diagnostics {
 /* Accumulated wall-clock time per phase since creation or the last reset. */
 typedef struct dem_profile {
     double neighbor_s;     /* cell binning, sorting, Verlet list build, history transfer */
-    double contact_s;      /* pair and wall contact forces, force gathering */
-    double integrate_s;    /* velocity Verlet kicks and drift, checks */
+    double contact_s;      /* the force sweep: pair and wall contacts, force gathering, and the
+                            * Verlet kicks and drift fused with them (see docs/libdem.md) */
+    double integrate_s;    /* the separate opening kick + drift of the first step of a call */
     int64_t steps;
     int64_t neighbor_builds;
     int64_t neighbor_pairs;  /* entries of the current (half) Verlet list */
