@@ -5,9 +5,10 @@
  * W = 40 mm; 40 -> 99,200, W = 88 mm); random initial velocities in +-0.05 m/s; g = 9.81;
  * dt = 1e-5 s; skin 0.2 mm. Settle, then time a number of steps at each thread count.
  *
- *   packed_bed [--n-side 18] [--mu-r 0.1] [--settle 20000] [--steps 5000] [--threads 1,2]
+ *   packed_bed [--n-side 18] [--mu-r 0.1] [--settle 20000] [--steps 5000] [--threads 1,2] [--repeat 1]
  *              [--settle-threads 2] [--csv FILE] [--demo] [--save FILE] [--load FILE]
- * Prints one line per thread count; --csv appends them as CSV rows. --save writes the settled
+ * Prints one line per timed run (each thread count, --repeat times over); --csv appends
+ * them as CSV rows. --save writes the settled
  * positions and velocities (raw doubles) and --load starts from them instead of the lattice
  * (contact springs start empty, so give --settle a few hundred steps after --load); this is
  * for quick profiling, the committed results settle from the lattice. */
@@ -74,7 +75,7 @@ static dem_domain *build_domain(const dem_domain_def *def, double mu_r, int *mat
 
 int main(int argc, char **argv)
 {
-    int n_side = 18, settle = 20000, steps = 5000, settle_threads = 2, demo = 0;
+    int n_side = 18, settle = 20000, steps = 5000, settle_threads = 2, demo = 0, repeat = 1;
     double mu_r = 0.1;
     const char *threads_arg = "1,2", *csv = NULL, *save = NULL, *load = NULL;
     for (int k = 1; k < argc; k++) {
@@ -82,6 +83,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[k], "--mu-r") && k + 1 < argc) mu_r = atof(argv[++k]);
         else if (!strcmp(argv[k], "--settle") && k + 1 < argc) settle = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--steps") && k + 1 < argc) steps = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads_arg = argv[++k];
         else if (!strcmp(argv[k], "--settle-threads") && k + 1 < argc) settle_threads = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--csv") && k + 1 < argc) csv = argv[++k];
@@ -89,7 +91,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[k], "--save") && k + 1 < argc) save = argv[++k];
         else if (!strcmp(argv[k], "--load") && k + 1 < argc) load = argv[++k];
         else {
-            fprintf(stderr, "usage: packed_bed [--n-side N] [--mu-r X] [--settle S] [--steps S] [--threads 1,2] "
+            fprintf(stderr, "usage: packed_bed [--n-side N] [--mu-r X] [--settle S] [--steps S] [--threads 1,2] [--repeat R] "
                             "[--settle-threads T] [--csv FILE] [--demo]\n");
             return 2;
         }
@@ -182,8 +184,10 @@ int main(int argc, char **argv)
     FILE *out = csv ? fopen(csv, "a") : NULL;
     char list[64];
     snprintf(list, sizeof list, "%s", threads_arg);
-    for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
-        int nt = atoi(tok);
+    int thread_counts[16], n_counts = 0;
+    for (char *tok = strtok(list, ","); tok && n_counts < 16; tok = strtok(NULL, ",")) thread_counts[n_counts++] = atoi(tok);
+    for (int run = 0; run < repeat * n_counts; run++) {
+        int nt = thread_counts[run % n_counts];
         dem_domain_set_num_threads(d, nt);
         dem_domain_profile_reset(d);
         double t1 = now_s();
