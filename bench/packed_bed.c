@@ -142,6 +142,10 @@ int main(int argc, char **argv)
     free(rad);
     free(mats);
 
+    if (demo)
+        printf("libdem %s: settling a packed bed of %lld glass-like spheres (d = 2 mm, E = 5 MPa, e = 0.5, "
+               "mu_s = 0.5, mu_r = %.2f EPSD2) in a %.0f mm box, %d steps of 10 us on %d threads\n",
+               dem_version_string(), (long long)n, mu_r, 1e3 * def.hi[0], settle, settle_threads);
     /* settle */
     double t0 = now_s();
     const int chunk = 1000;

@@ -9,13 +9,7 @@
 static const double R = 1e-3, E = 1e7, L = 0.015;
 
 static uint64_t rng = 88172645463325252ULL;
-static double urand(void) /* xorshift64, uniform in [0, 1) */
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
-}
+static double urand(void) { return test_urand(&rng); }
 
 static dem_domain *make_gas(double e, double mu, double dt, int n_side)
 {

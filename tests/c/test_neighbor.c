@@ -9,13 +9,7 @@ enum { N = 400 };
 static const double L = 0.03;
 
 static uint64_t rng = 0x9E3779B97F4A7C15ULL;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
-}
+static double urand(void) { return test_urand(&rng); }
 
 static int64_t brute_force_contacts(dem_domain *d)
 {

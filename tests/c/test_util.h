@@ -70,6 +70,15 @@ static inline dem_domain *make_domain(double box, double dt, double E, double e,
     return d;
 }
 
+/* xorshift64: uniform in [0, 1), reproducible across machines (no libc rand). */
+static inline double test_urand(uint64_t *state)
+{
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    return (double)(*state >> 11) / 9007199254740992.0;
+}
+
 /* Effective constants of the seed-000 law for identical materials. */
 static inline double e_star_same(double E, double nu) { return E / (2.0 * (1.0 - nu * nu)); }
 static inline double sphere_mass(double rho, double r) { return rho * 4.0 / 3.0 * M_PI * r * r * r; }
