@@ -1,6 +1,7 @@
 # libdem / pydem — one entry point.
 #   make            static + shared library (strict warnings, warnings are errors)
-#   make test       set-up (idempotent), build, every C test, then the Python tests
+#   make test       set-up (idempotent), build, every C test (plain, then under ASan/UBSan),
+#                   then the Python tests
 #   make bench      benchmarks (results in bench/results/)
 #   make demo       the main job
 #   make install PREFIX=/usr/local
@@ -20,7 +21,7 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib setup test test-c test-py bench demo install clean FORCE
+.PHONY: all lib setup test test-c test-sanitize test-py bench demo install clean FORCE
 
 all: lib
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
@@ -51,7 +52,16 @@ $(BUILD)/tests/%: tests/c/%.c tests/c/test_util.h $(BUILD)/libdem.a
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)
 
 test: setup
-	@$(MAKE) --no-print-directory test-c test-py
+	@$(MAKE) --no-print-directory test-c test-sanitize test-py
+
+# every C test again under AddressSanitizer + UndefinedBehaviorSanitizer (+ leak check)
+SAN_OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+test-sanitize:
+	@echo "== C tests under ASan + UBSan"
+	@mkdir -p $(BUILD)
+	@$(MAKE) --no-print-directory -s BUILD=$(BUILD)/sanitize OPT="$(SAN_OPT)" test-c > $(BUILD)/sanitize.log 2>&1 \
+	  || (cat $(BUILD)/sanitize.log; echo "sanitizer run FAILED (log: $(BUILD)/sanitize.log)"; exit 1)
+	@grep -cE "^\[  PASSED  \]" $(BUILD)/sanitize.log | xargs printf "   %s test programs passed (log: $(BUILD)/sanitize.log)\n"
 
 test-c: lib $(TEST_BIN) $(BUILD)/readme_example
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; OMP_NUM_THREADS=2 $$t; done

@@ -206,6 +206,39 @@ static void test_broken_runs_name_the_particle(void **st)
     dem_domain_destroy(d);
 }
 
+static void test_lifecycle_edges(void **st)
+{
+    (void)st;
+    int mat;
+    dem_domain *d = make_domain(0.01, 1e-6, 1e7, 0.5, 0.5, &mat);
+    assert_ok(dem_domain_step(d, 10)); /* no particles: time still advances */
+    dem_diagnostics g;
+    assert_ok(dem_domain_diagnostics(d, &g));
+    assert_int_equal(g.step, 10);
+    double pos[6] = {0.003, 0.005, 0.005, 0.007, 0.005, 0.005}, rad[2] = {1e-3, 1e-3}, v[6];
+    int mats[2] = {mat, mat};
+    dem_particle_id ids[2], more[2];
+    assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, ids));
+    assert_ok(dem_domain_step(d, 10));
+    assert_ok(dem_particles_remove(d, 2, ids)); /* remove everything */
+    assert_int_equal(dem_particle_count(d), 0);
+    assert_ok(dem_domain_step(d, 10));
+    assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, more)); /* ids are never reused */
+    assert_true(more[0] == ids[1] + 1 && more[1] == ids[1] + 2);
+    assert_status(dem_particles_get_positions(d, NULL), DEM_ERR_NULL);
+    double bad_v[6] = {0, 0, 0, NAN, 0, 0};
+    assert_status(dem_particles_set_velocities(d, bad_v), DEM_ERR_INVALID_ARGUMENT);
+    assert_ok(dem_particles_get_velocities(d, v));
+    for (int k = 0; k < 6; k++) assert_true(v[k] == 0.0); /* unchanged */
+    dem_particle_id twice[2] = {more[0], more[0]};
+    assert_status(dem_particles_remove(d, 2, twice), DEM_ERR_UNKNOWN_PARTICLE);
+    assert_msg(d, "listed twice");
+    assert_int_equal(dem_particle_count(d), 2);
+    assert_ok(dem_domain_step(d, 10));
+    dem_domain_destroy(d);
+    dem_domain_destroy(NULL); /* harmless */
+}
+
 static void test_periodic_too_small(void **st)
 {
     (void)st;
@@ -233,6 +266,7 @@ int main(void)
         cmocka_unit_test(test_timestep_checks),
         cmocka_unit_test(test_broken_runs_name_the_particle),
         cmocka_unit_test(test_periodic_too_small),
+        cmocka_unit_test(test_lifecycle_edges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
