@@ -37,7 +37,7 @@ typedef struct contact_out {
 DEM_INLINE void vec_project_keep_length(double *h, const double *n)
 {
     /* Rotate a history vector into the current tangent plane: project, restore length.
-     * Written without branches, exactly as the batch kernel in forces.c does it. */
+     * The guard on p2 makes h = 0 (a new contact) come out as 0 without a branch. */
     const double h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
     const double hn = h[0] * n[0] + h[1] * n[1] + h[2] * n[2];
     h[0] -= hn * n[0];

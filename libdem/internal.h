@@ -88,7 +88,7 @@ struct dem_domain {
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
-    int64_t trans_capacity;
+    int64_t trans_capacity;   /* entries the slot and trans_entry arrays can hold */
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
     int64_t n_cells, cap_cells;
@@ -105,7 +105,6 @@ struct dem_domain {
     double time;
     dem_profile profile;
     double rayleigh_cache;    /* < 0: stale */
-    int bad_index;            /* numerical-failure scratch */
     int forces_valid;         /* f/t belong to the current state */
 };
 
