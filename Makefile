@@ -8,7 +8,11 @@
 CC      ?= gcc
 PREFIX  ?= /usr/local
 BUILD   := build
-OPT     ?= -O3 -fno-math-errno -fno-trapping-math
+# AVX2 encoding when both the compiler and this machine support it: measured ~15 % faster on
+# the benchmark machine; results are unchanged (no FMA contraction under -std=c99). Set
+# ARCH_OPT= to build for any x86-64, e.g. for a library shipped to other machines.
+ARCH_OPT ?= $(shell grep -qw avx2 /proc/cpuinfo 2>/dev/null && $(CC) -march=x86-64-v3 -x c -c /dev/null -o /dev/null 2>/dev/null && echo -march=x86-64-v3)
+OPT     ?= -O3 -fno-math-errno -fno-trapping-math $(ARCH_OPT)
 CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem
 LDLIBS  += -lm
 PYTHON  := .venv/bin/python
