@@ -39,6 +39,12 @@ static long peak_rss_kb(void)
     return kb;
 }
 
+/* Contacts per particle: a pair contact counts for both spheres, a wall contact for one. */
+static double contacts_per_particle(const dem_diagnostics *g, int64_t n)
+{
+    return (2.0 * (double)(g->contact_count - g->wall_contact_count) + (double)g->wall_contact_count) / (double)n;
+}
+
 static void die(dem_domain *d, dem_status s, const char *what)
 {
     fprintf(stderr, "packed_bed: %s: %s: %s\n", what, dem_status_name(s), d ? dem_domain_last_error(d) : "");
@@ -156,9 +162,7 @@ int main(int argc, char **argv)
             dem_diagnostics g;
             dem_domain_diagnostics(d, &g);
             printf("  t = %.3f s  kinetic energy %.3e J  contacts/particle %.2f  max overlap %.3f R  (%.1f s)\n",
-                   g.time, g.kinetic_energy,
-                   (2.0 * (double)(g.contact_count - g.wall_contact_count) + (double)g.wall_contact_count) / (double)n,
-                   g.max_overlap_ratio,
+                   g.time, g.kinetic_energy, contacts_per_particle(&g, n), g.max_overlap_ratio,
                    now_s() - t0);
             fflush(stdout);
         }
@@ -210,8 +214,7 @@ int main(int argc, char **argv)
         dem_domain_profile(d, &one);
         double integ_frac = (one.integrate_s / 100.0) / (el / steps);
         double rate = (double)n * steps / el;
-        /* contacts per particle: a pair contact counts for both spheres, a wall contact for one */
-        double cpp = (2.0 * (double)(g.contact_count - g.wall_contact_count) + (double)g.wall_contact_count) / (double)n;
+        double cpp = contacts_per_particle(&g, n);
         double mem_pp = (double)dem_domain_memory_bytes(d) / (double)n;
         long rss = peak_rss_kb();
         printf("N=%lld mu_r=%.2f threads=%d: %.3f M particle-steps/s  (%.2f s for %d steps)  contacts/particle %.2f  "

@@ -114,7 +114,6 @@ void dem_domain_destroy(dem_domain *d)
     if (!d) return;
     free(d->materials);
     free(d->pairs);
-    free(d->pair_set);
     double *dbl[] = {d->x, d->v, d->w, d->f, d->t, d->x_build, d->radius, d->inv_mass, d->inv_inertia};
     for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++) free(dbl[k]);
     free(d->mat);

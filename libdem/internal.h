@@ -62,7 +62,6 @@ struct dem_domain {
     int n_materials, cap_materials;
     dem_material_def *materials;
     pair_props *pairs;        /* n_materials^2, symmetric */
-    unsigned char *pair_set;  /* n_materials^2 flags: set explicitly by the user */
 
     /* particles, in internal (spatially sorted) order */
     int64_t n, cap;

@@ -66,22 +66,18 @@ dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *
     int n_old = d->n_materials, n = n_old + 1;
     dem_material_def *mats = dem_realloc_array(NULL, (size_t)n, sizeof *mats);
     pair_props *pairs = dem_realloc_array(NULL, (size_t)n * n, sizeof *pairs);
-    unsigned char *set = dem_realloc_array(NULL, (size_t)n * n, 1);
-    if (!mats || !pairs || !set) {
+    if (!mats || !pairs) {
         free(mats);
         free(pairs);
-        free(set);
         return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_material_create: out of memory");
     }
     if (n_old) memcpy(mats, d->materials, (size_t)n_old * sizeof *mats);
     mats[n_old] = *def;
-    memset(set, 0, (size_t)n * n);
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             pair_props *p = &pairs[(size_t)a * n + b];
             if (a < n_old && b < n_old) {
                 *p = d->pairs[(size_t)a * n_old + b];
-                set[(size_t)a * n + b] = d->pair_set[(size_t)a * n_old + b];
             } else {
                 memset(p, 0, sizeof *p);
                 p->def = dem_default_pair_def();
@@ -89,10 +85,8 @@ dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *
         }
     free(d->materials);
     free(d->pairs);
-    free(d->pair_set);
     d->materials = mats;
     d->pairs = pairs;
-    d->pair_set = set;
     d->n_materials = n;
     for (int a = 0; a < n; a++) dem_pair_recompute(d, a, n_old);
     d->rayleigh_cache = -1.0;
@@ -136,7 +130,6 @@ dem_status dem_pair_set(dem_domain *d, int a, int b, const dem_pair_def *def)
     pair_props *p = &d->pairs[(size_t)a * d->n_materials + b];
     p->def = *def;
     dem_pair_recompute(d, a, b);
-    d->pair_set[(size_t)a * d->n_materials + b] = d->pair_set[(size_t)b * d->n_materials + a] = 1;
     d->forces_valid = 0;
     dem_clear_error(d);
     return DEM_OK;

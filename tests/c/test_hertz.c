@@ -11,8 +11,8 @@ static const double R = 1e-3, RHO = 2500, E = 1e8, NU = 0.25;
 
 typedef struct impact { double max_overlap, peak_force, contact_time; } impact;
 
-/* Steps until the contact has ended; overlap_of returns the current overlap. */
-static impact run_impact(dem_domain *d, int n, int wall, double dt)
+/* Steps until the contact has ended; wall: sphere 0 on the floor, else spheres 0 and 1. */
+static impact run_impact(dem_domain *d, int wall, double dt)
 {
     impact r = {0, 0, 0};
     double x[6], f[6];
@@ -23,7 +23,6 @@ static impact run_impact(dem_domain *d, int n, int wall, double dt)
         assert_ok(dem_particles_get_positions(d, x));
         assert_ok(dem_particles_get_forces(d, f));
         double overlap = wall ? R - x[2] : 2 * R - fabs(x[5] - x[2]);
-        (void)n;
         double fz = fabs(f[2]);
         if (overlap > 0) {
             in_contact = 1;
@@ -58,11 +57,8 @@ static void test_sphere_sphere(void **state)
     int mat;
     dem_domain *d = make_domain(0.01, dt, E, 1.0, 0.0, &mat);
     assert_non_null(d);
-    double pos[6] = {0.005, 0.005, 0.005 - R - 1e-7, 0.005, 0.005, 0.005 + R + 1e-7};
-    double rad[2] = {R, R}, vel[6] = {0, 0, v / 2, 0, 0, -v / 2};
-    int mats[2] = {mat, mat};
-    assert_ok(dem_particles_add(d, 2, pos, rad, mats, vel, NULL, NULL));
-    check(run_impact(d, 2, 0, dt), m_eff, v, es, r_eff);
+    add_head_on_pair(d, mat, 0.005, R, 2e-7, v);
+    check(run_impact(d, 0, dt), m_eff, v, es, r_eff);
     dem_domain_destroy(d);
 }
 
@@ -72,16 +68,11 @@ static void test_sphere_wall(void **state)
     const double v = 0.2;
     double m = sphere_mass(RHO, R), es = e_star_same(E, NU);
     double tc = 2.94328 * hertz_max_overlap(m, v, es, R) / v, dt = tc / 4000;
-    int mat, wall;
+    int mat;
     dem_domain *d = make_domain(0.01, dt, E, 1.0, 0.0, &mat);
     assert_non_null(d);
-    dem_plane_wall_def w = dem_default_plane_wall_def();
-    w.material = mat;
-    assert_ok(dem_plane_wall_add(d, &w, &wall));
-    double pos[3] = {0.005, 0.005, R + 1e-7}, rad[1] = {R}, vel[3] = {0, 0, -v};
-    int mats[1] = {mat};
-    assert_ok(dem_particles_add(d, 1, pos, rad, mats, vel, NULL, NULL));
-    check(run_impact(d, 1, 1, dt), m, v, es, R);
+    add_sphere_over_floor(d, mat, 0.005, R, 1e-7, v);
+    check(run_impact(d, 1, dt), m, v, es, R);
     dem_domain_destroy(d);
 }
 

@@ -10,14 +10,9 @@ static const double R = 1e-3, E = 1e9;
 
 static double wall_rebound(double e, double v, double dt)
 {
-    int mat, wall;
+    int mat;
     dem_domain *d = make_domain(0.1, dt, E, e, 0.5, &mat);
-    dem_plane_wall_def w = dem_default_plane_wall_def();
-    w.material = mat;
-    assert_ok(dem_plane_wall_add(d, &w, &wall));
-    double pos[3] = {0.05, 0.05, R + 1e-9}, rad[1] = {R}, vel[3] = {0, 0, -v};
-    int mats[1] = {mat};
-    assert_ok(dem_particles_add(d, 1, pos, rad, mats, vel, NULL, NULL));
+    add_sphere_over_floor(d, mat, 0.05, R, 1e-9, v);
     double x[3], u[3];
     for (int s = 0; s < 100000; s++) {
         assert_ok(dem_domain_step(d, 1));
@@ -33,10 +28,7 @@ static double pair_rebound(double e, double v, double dt)
 {
     int mat;
     dem_domain *d = make_domain(0.1, dt, E, e, 0.5, &mat);
-    double pos[6] = {0.05, 0.05, 0.05 - R - 1e-9, 0.05, 0.05, 0.05 + R + 1e-9};
-    double rad[2] = {R, R}, vel[6] = {0, 0, v / 2, 0, 0, -v / 2};
-    int mats[2] = {mat, mat};
-    assert_ok(dem_particles_add(d, 2, pos, rad, mats, vel, NULL, NULL));
+    add_head_on_pair(d, mat, 0.05, R, 2e-9, v);
     double x[6], u[6];
     for (int s = 0; s < 100000; s++) {
         assert_ok(dem_domain_step(d, 1));

@@ -79,6 +79,27 @@ static inline double test_urand(uint64_t *state)
     return (double)(*state >> 11) / 9007199254740992.0;
 }
 
+/* One sphere of radius r at (c, c, r + gap) falling at speed v onto a floor z >= 0 made
+ * of the same material. */
+static inline void add_sphere_over_floor(dem_domain *d, int mat, double c, double r, double gap, double v)
+{
+    int wall;
+    dem_plane_wall_def w = dem_default_plane_wall_def();
+    w.material = mat;
+    assert_ok(dem_plane_wall_add(d, &w, &wall));
+    double pos[3] = {c, c, r + gap}, vel[3] = {0, 0, -v};
+    assert_ok(dem_particles_add(d, 1, pos, &r, &mat, vel, NULL, NULL));
+}
+
+/* Two spheres of radius r on the z axis through (c, c, c), gap apart, closing at speed v. */
+static inline void add_head_on_pair(dem_domain *d, int mat, double c, double r, double gap, double v)
+{
+    double pos[6] = {c, c, c - r - gap / 2, c, c, c + r + gap / 2};
+    double rad[2] = {r, r}, vel[6] = {0, 0, v / 2, 0, 0, -v / 2};
+    int mats[2] = {mat, mat};
+    assert_ok(dem_particles_add(d, 2, pos, rad, mats, vel, NULL, NULL));
+}
+
 /* Effective constants of the seed-000 law for identical materials. */
 static inline double e_star_same(double E, double nu) { return E / (2.0 * (1.0 - nu * nu)); }
 static inline double sphere_mass(double rho, double r) { return rho * 4.0 / 3.0 * M_PI * r * r * r; }
