@@ -51,7 +51,7 @@ $(BUILD)/dem.pc: FORCE
 setup:
 	@sh scripts/setup.sh
 
-$(BUILD)/tests/%: tests/c/%.c tests/c/test_util.h $(BUILD)/libdem.a
+$(BUILD)/tests/%: tests/c/%.c $(wildcard tests/c/*.h) $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)
 

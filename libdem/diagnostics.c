@@ -59,6 +59,21 @@ dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
             double ratio = delta / d->radius[i];
             if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
         }
+        const tri_list *tl = &d->tris_cur;
+        for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) { /* accepted mesh contacts */
+            if (!tl->active[k]) continue;
+            const double *q = tl->point + 3 * k, *p = d->x + 3 * i;
+            double u2 = 0.0;
+            for (int a = 0; a < 3; a++) u2 += (p[a] - q[a]) * (p[a] - q[a]);
+            double delta = d->radius[i] - sqrt(u2);
+            if (delta <= 0.0) continue;
+            out->contact_count++;
+            out->wall_contact_count++;
+            int wm = d->meshes[tl->mesh[k]].material;
+            out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], wm)->e_star, d->radius[i], delta);
+            double ratio = delta / d->radius[i];
+            if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
+        }
     }
     return DEM_OK;
 }

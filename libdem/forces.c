@@ -26,6 +26,13 @@ dem_status dem_report_runaway_pair(dem_domain *d, int64_t k)
 /* Cold path: particle i overlapped a plane wall beyond the limit during this step. */
 dem_status dem_report_runaway_wall(dem_domain *d, int64_t i)
 {
+    int plane = 0;
+    for (int64_t k = d->walls_cur.start[i]; k < d->walls_cur.start[i + 1]; k++) {
+        const plane_wall *pw = &d->walls[d->walls_cur.wall[k]];
+        double dist = (d->x[3 * i + pw->def.axis] - pw->def.position) * pw->def.side;
+        plane |= d->radius[i] - dist > d->def.max_overlap_ratio * d->radius[i];
+    }
+    if (!plane) return dem_report_runaway_mesh(d, i);
     return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
                     "runaway overlap during step %lld: particle id %lld overlaps a plane wall by more than %g of its "
                     "radius %s",

@@ -32,6 +32,45 @@ typedef struct plane_wall {
     double normal[3];
 } plane_wall;
 
+/* A triangle-mesh wall. Vertices are stored as loaded (reference) and as moved (world):
+ * x = R x0 + t. Rotation is about the world point `centre`, which moves with the wall. */
+typedef struct mesh_wall {
+    int material;
+    int64_t nv, nt, ne;
+    double *x_ref, *x;       /* 3 nv */
+    double *x_build;         /* 3 nv: world vertices at the last neighbour build */
+    int32_t *tri;            /* 3 nt vertex indices */
+    int32_t *tri_edge;       /* 3 nt edge ids: edges (v0 v1), (v1 v2), (v2 v0) */
+    int32_t *edge_ntri;      /* ne: triangles sharing the edge */
+    double *normal;          /* 3 nt, unit, world */
+    int64_t skipped_degenerate, input_triangles;
+    /* pose and motion */
+    double rot[9], trans[3]; /* R row-major, t */
+    double centre[3];        /* rotation centre, world, m */
+    double velocity[3], omega[3];
+    int moving;              /* any non-zero motion or servo */
+    int binned;              /* its triangles are in the cell bins at their current place */
+    /* load control */
+    int servo_on;
+    dem_servo_def servo;
+    double servo_force;      /* filtered measured force along -direction, N */
+    int servo_primed;        /* the filter has seen a first value */
+} mesh_wall;
+
+/* Mesh-triangle contact candidates, grouped by particle (CSR over particles). An entry is
+ * "active" when it carried an accepted contact at the last evaluation. */
+typedef struct tri_list {
+    int64_t n_rows;          /* particles covered */
+    int64_t count, capacity;
+    int64_t *start;          /* n + 1 */
+    int32_t *mesh, *tri;
+    uint8_t *active;
+    double *hist;            /* 6 per entry: tangential spring (3), rolling torque (3) */
+    double *force;           /* 3 per entry: force on the particle, last step */
+    double *point;           /* 3 per entry: contact point, last step */
+    double *normal;          /* 3 per entry: contact normal (towards the particle), last step */
+} tri_list;
+
 /* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the
  * partner j, the periodic image code of j, the contact histories, and whether the pair
  * touched at the last evaluation (its reaction slot then holds non-zero values). */
@@ -79,9 +118,20 @@ struct dem_domain {
     int n_walls, cap_walls;
     plane_wall *walls;
 
+    /* mesh walls */
+    int n_meshes, cap_meshes;
+    mesh_wall *meshes;
+    double mesh_disp;         /* largest mesh-vertex displacement since the last build, m */
+    int64_t *tri_cell_start;  /* n_cells + 1: triangles near each cell (CSR) */
+    int32_t *tri_cell_mesh, *tri_cell_tri;
+    int64_t tri_cell_count, tri_cell_capacity;
+    int tri_cell_ncell[3];    /* the grid they were made for */
+    double tri_cell_reach;    /* and the reach (r_max + skin) */
+
     /* neighbour search */
     pair_list pairs_cur, pairs_old;
     wall_list walls_cur, walls_old;
+    tri_list tris_cur, tris_old;
     double *slot;             /* 6 per pair entry: contact force on i (the partner gets minus
                                * it), torque on the partner; written while the pair touches */
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
@@ -134,6 +184,25 @@ int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
 dem_status dem_report_runaway_pair(dem_domain *d, int64_t k);
 dem_status dem_report_runaway_wall(dem_domain *d, int64_t i);
+
+/* mesh_contact.c: mesh contacts of particle i added to f/t (*bad: i if an overlap runs away
+ * or too many triangles touch, min). */
+void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
+dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i);
+
+/* mesh_bins.c: candidate triangles of every particle (called by the neighbour build) */
+dem_status dem_mesh_candidates(dem_domain *d);
+void dem_mesh_free_all(dem_domain *d);
+
+/* mesh_motion.c: servo update from the forces of the step just computed, then the rigid
+ * motion of every moving mesh over dt (keeps d->mesh_disp up to date) */
+void dem_meshes_update_servos(dem_domain *d);
+void dem_meshes_move(dem_domain *d, double dt);
+void dem_mesh_update_world(mesh_wall *m);
+/* first of the n particles (x, r) that a mesh cuts (*which_mesh), or -1 */
+int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x, const double *r, int *which_mesh);
+/* force the particles exert on mesh m during the last step (N) */
+void dem_mesh_total_force(const dem_domain *d, int m, double force[3]);
 
 /* step.c */
 double dem_rayleigh_time(dem_domain *d);

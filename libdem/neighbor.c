@@ -358,6 +358,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     }
     wl->count = wc;
 
+    s = dem_mesh_candidates(d);
+    if (s != DEM_OK) return s;
     d->need_rebuild = 0;
     d->profile.neighbor_builds++;
     return DEM_OK;

@@ -177,6 +177,11 @@ dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const 
                                 w);
         }
     }
+    int cut_mesh = -1;
+    int64_t cut = dem_meshes_cut_particles(d, n, pos, rad, &cut_mesh);
+    if (cut >= 0)
+        return dem_fail(d, DEM_ERR_OVERLAP, "dem_particles_add: particle %lld overlaps mesh wall %d", (long long)cut,
+                        cut_mesh);
     int no_memory = 0;
     int64_t other = -1;
     int64_t bad = find_overlap(d, n, pos, rad, &other, &no_memory);

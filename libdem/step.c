@@ -59,8 +59,9 @@ dem_status dem_domain_timestep_info(dem_domain *d, dem_timestep_info *info)
                                   ma * mb / (ma + mb), v);
             if (t < tc) tc = t;
         }
-        for (int w = 0; w < d->n_walls; w++) {
-            double t = hertz_time(dem_pair_props(d, a, d->walls[w].def.material)->e_star, rmin[a], ma, v);
+        for (int w = 0; w < d->n_walls + d->n_meshes; w++) {
+            int wm = w < d->n_walls ? d->walls[w].def.material : d->meshes[w - d->n_walls].material;
+            double t = hertz_time(dem_pair_props(d, a, wm)->e_star, rmin[a], ma, v);
             if (t < tc) tc = t;
         }
     }
@@ -82,6 +83,7 @@ static dem_status refresh_forces(dem_domain *d)
     sweep_result r = dem_sweep(d, 0.0, SWEEP_FORCES);
     if (r.bad_pair != INT64_MAX) return dem_report_runaway_pair(d, r.bad_pair);
     if (r.bad_wall != INT64_MAX) return dem_report_runaway_wall(d, r.bad_wall);
+    dem_meshes_update_servos(d);
     d->forces_valid = 1;
     return DEM_OK;
 }
@@ -123,9 +125,15 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
     const double dt = d->def.dt;
     dem_status result = DEM_OK;
     dem_clear_error(d);
-    if (d->n == 0) {
-        d->step += n_steps;
-        d->time += (double)n_steps * dt;
+    if (d->n == 0) { /* nothing to collide: time passes, walls move */
+        d->tris_cur.count = 0;
+        for (int64_t s = 0; s < n_steps; s++) {
+            dem_meshes_update_servos(d);
+            dem_meshes_move(d, dt);
+            d->step++;
+            d->time += dt;
+        }
+        d->need_rebuild = 1;
         return DEM_OK;
     }
     const double tr = dem_rayleigh_time(d);
@@ -150,6 +158,7 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
     const double skin_half2 = 0.25 * d->def.skin * d->def.skin;
     double t0 = now_s();
     sweep_result m = open_first_step(d);
+    dem_meshes_move(d, dt); /* walls drift with the particles */
     d->profile.integrate_s += now_s() - t0;
     for (int64_t s = 0; s < n_steps; s++) {
         if (m.bad_nan != INT64_MAX) {
@@ -165,7 +174,9 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
                             (long long)d->step + 1, (long long)d->id[m.bad_out], p[0], p[1], p[2]);
         }
         double t1 = now_s();
-        if (m.maxdisp2 > skin_half2) {
+        /* pairs need each particle within skin/2 of its build position; particle-triangle
+         * candidates need particle + wall displacement within the skin */
+        if (m.maxdisp2 > skin_half2 || sqrt(m.maxdisp2) + d->mesh_disp > d->def.skin) {
             dem_status st = dem_neighbor_rebuild(d, NULL);
             if (st != DEM_OK) return st;
         }
@@ -179,6 +190,8 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
             return m.bad_pair != INT64_MAX ? dem_report_runaway_pair(d, m.bad_pair)
                                            : dem_report_runaway_wall(d, m.bad_wall);
         }
+        dem_meshes_update_servos(d);
+        if (s + 1 < n_steps) dem_meshes_move(d, dt);
         d->step++;
         d->time += dt;
         d->profile.steps++;

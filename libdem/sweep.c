@@ -114,6 +114,7 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
         t[2] += sl[5];
     }
     if (d->walls_cur.start[p] < d->walls_cur.start[p + 1]) dem_wall_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
+    if (d->tris_cur.start[p] < d->tris_cur.start[p + 1]) dem_mesh_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
     double *fp = d->f + 3 * p, *tp = d->t + 3 * p;
     for (int a = 0; a < 3; a++) {
         fp[a] = f[a];

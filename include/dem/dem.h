@@ -10,6 +10,7 @@
 
 #include "base.h"
 #include "types.h"
+#include "mesh.h"
 
 #ifdef __cplusplus
 extern "C" {

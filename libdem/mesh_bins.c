@@ -1,0 +1,179 @@
+/* Mesh-triangle candidates for the Verlet scheme: triangles are binned into the particle
+ * cell grid (every triangle within reach = r_max + skin of some point of a cell is listed
+ * there), then each particle keeps the triangles of its own cell that lie within r + skin.
+ * Bins are remade only when a mesh moved or the grid changed. Histories follow the
+ * (particle, mesh, triangle) entries across builds. */
+#include "internal.h"
+#include "triangle.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int64_t grown(int64_t need) { return need + need / 4 + 256; }
+
+static int tri_list_reserve(tri_list *tl, int64_t need)
+{
+    if (need <= tl->capacity) return 1;
+    int64_t c = grown(need);
+    void **i32[] = {(void **)&tl->mesh, (void **)&tl->tri};
+    void **u8[] = {(void **)&tl->active};
+    void **h6[] = {(void **)&tl->hist};
+    void **v3[] = {(void **)&tl->force, (void **)&tl->point, (void **)&tl->normal};
+    if (!dem_realloc_all(i32, 2, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(u8, 1, (size_t)c, 1) ||
+        !dem_realloc_all(h6, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(v3, 3, (size_t)c * 3, sizeof(double)))
+        return 0;
+    tl->capacity = c;
+    return 1;
+}
+
+static int cell_index(const dem_domain *d, double x, int a)
+{
+    double c = floor((x - d->def.lo[a]) / d->cell_size[a]);
+    if (!(c >= 0.0)) return 0;
+    if (c >= d->ncell[a]) return d->ncell[a] - 1;
+    return (int)c;
+}
+
+/* Visit (count or fill) the cells near triangle t of mesh m. */
+static int64_t bin_triangle(dem_domain *d, int mi, int64_t t, double reach, int fill)
+{
+    const mesh_wall *m = &d->meshes[mi];
+    const double *v[3] = {m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2]};
+    int c0[3], c1[3];
+    double half2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double lo = fmin(v[0][a], fmin(v[1][a], v[2][a])) - reach, hi = fmax(v[0][a], fmax(v[1][a], v[2][a])) + reach;
+        if (hi < d->def.lo[a] || lo > d->def.hi[a]) return 0; /* entirely outside the domain */
+        c0[a] = cell_index(d, lo, a);
+        c1[a] = cell_index(d, hi, a);
+        half2 += 0.25 * d->cell_size[a] * d->cell_size[a];
+    }
+    const double lim = reach + sqrt(half2);
+    int64_t added = 0;
+    for (int cz = c0[2]; cz <= c1[2]; cz++)
+        for (int cy = c0[1]; cy <= c1[1]; cy++)
+            for (int cx = c0[0]; cx <= c1[0]; cx++) {
+                double centre[3] = {d->def.lo[0] + (cx + 0.5) * d->cell_size[0], d->def.lo[1] + (cy + 0.5) * d->cell_size[1],
+                                    d->def.lo[2] + (cz + 0.5) * d->cell_size[2]}, q[3];
+                tri_closest_point(centre, v[0], v[1], v[2], q);
+                if (tri_dist2(centre, q) > lim * lim) continue;
+                int64_t c = ((int64_t)cz * d->ncell[1] + cy) * d->ncell[0] + cx;
+                if (fill) {
+                    int64_t slot = d->cursor[c]++;
+                    d->tri_cell_mesh[slot] = mi;
+                    d->tri_cell_tri[slot] = (int32_t)t;
+                } else {
+                    d->tri_cell_start[c + 1]++;
+                }
+                added++;
+            }
+    return added;
+}
+
+static dem_status bin_triangles(dem_domain *d, double reach)
+{
+    int64_t *st = dem_realloc_array(d->tri_cell_start, (size_t)d->n_cells + 1, sizeof *st);
+    if (!st) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
+    d->tri_cell_start = st;
+    memset(st, 0, (size_t)(d->n_cells + 1) * sizeof *st);
+    for (int mi = 0; mi < d->n_meshes; mi++)
+        for (int64_t t = 0; t < d->meshes[mi].nt; t++) bin_triangle(d, mi, t, reach, 0);
+    for (int64_t c = 0; c < d->n_cells; c++) st[c + 1] += st[c];
+    int64_t total = st[d->n_cells];
+    if (total > d->tri_cell_capacity) {
+        int64_t cap = grown(total);
+        void **arr[] = {(void **)&d->tri_cell_mesh, (void **)&d->tri_cell_tri};
+        if (!dem_realloc_all(arr, 2, (size_t)cap, sizeof(int32_t)))
+            return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
+        d->tri_cell_capacity = cap;
+    }
+    memcpy(d->cursor, st, (size_t)(d->n_cells + 1) * sizeof *st); /* the cursor holds >= n_cells + 1 */
+    for (int mi = 0; mi < d->n_meshes; mi++)
+        for (int64_t t = 0; t < d->meshes[mi].nt; t++) bin_triangle(d, mi, t, reach, 1);
+    d->tri_cell_count = total;
+    for (int a = 0; a < 3; a++) d->tri_cell_ncell[a] = d->ncell[a];
+    d->tri_cell_reach = reach;
+    for (int mi = 0; mi < d->n_meshes; mi++) d->meshes[mi].binned = 1;
+    return DEM_OK;
+}
+
+/* Copy entry q of the old list into entry k of the new one. */
+static void carry_entry(const tri_list *old, int64_t q, tri_list *tl, int64_t k)
+{
+    tl->active[k] = old->active[q];
+    memcpy(tl->hist + 6 * k, old->hist + 6 * q, 6 * sizeof(double));
+    memcpy(tl->force + 3 * k, old->force + 3 * q, 3 * sizeof(double));
+    memcpy(tl->point + 3 * k, old->point + 3 * q, 3 * sizeof(double));
+    memcpy(tl->normal + 3 * k, old->normal + 3 * q, 3 * sizeof(double));
+}
+
+static void clear_entry(tri_list *tl, int64_t k)
+{
+    tl->active[k] = 0;
+    memset(tl->hist + 6 * k, 0, 6 * sizeof(double));
+    memset(tl->force + 3 * k, 0, 3 * sizeof(double));
+    memset(tl->point + 3 * k, 0, 3 * sizeof(double));
+    memset(tl->normal + 3 * k, 0, 3 * sizeof(double));
+}
+
+dem_status dem_mesh_candidates(dem_domain *d)
+{
+    const int64_t n = d->n;
+    tri_list tmp = d->tris_old;
+    d->tris_old = d->tris_cur;
+    d->tris_cur = tmp;
+    tri_list *tl = &d->tris_cur;
+    const tri_list *old = &d->tris_old;
+    int64_t *start = dem_realloc_array(tl->start, (size_t)n + 1, sizeof *start);
+    if (!start) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    tl->start = start;
+    start[0] = 0;
+    tl->count = 0;
+    d->mesh_disp = 0.0;
+    if (d->n_meshes == 0) {
+        memset(start, 0, (size_t)(n + 1) * sizeof *start);
+        tl->n_rows = n;
+        return DEM_OK;
+    }
+    const double skin = d->def.skin, reach = d->r_max + skin;
+    int stale = reach != d->tri_cell_reach;
+    for (int a = 0; a < 3; a++) stale |= d->tri_cell_ncell[a] != d->ncell[a];
+    for (int mi = 0; mi < d->n_meshes; mi++) stale |= !d->meshes[mi].binned;
+    if (stale) {
+        dem_status s = bin_triangles(d, reach);
+        if (s != DEM_OK) return s;
+    }
+    for (int mi = 0; mi < d->n_meshes; mi++)
+        memcpy(d->meshes[mi].x_build, d->meshes[mi].x, (size_t)d->meshes[mi].nv * 3 * sizeof(double));
+
+    const int64_t old_rows = old->start ? old->n_rows : 0;
+    int64_t count = 0;
+    for (int64_t i = 0; i < n; i++) {
+        const double *p = d->x + 3 * i;
+        const double cut = d->radius[i] + skin;
+        const int64_t c = d->cell_of[i];
+        for (int64_t s = d->tri_cell_start[c]; s < d->tri_cell_start[c + 1]; s++) {
+            const mesh_wall *m = &d->meshes[d->tri_cell_mesh[s]];
+            const int32_t t = d->tri_cell_tri[s];
+            double q[3];
+            tri_closest_point(p, m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2], q);
+            if (tri_dist2(p, q) >= cut * cut) continue;
+            if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+            tl->mesh[count] = d->tri_cell_mesh[s];
+            tl->tri[count] = t;
+            clear_entry(tl, count);
+            int32_t oi = d->perm[i];
+            if (oi < old_rows)
+                for (int64_t k = old->start[oi]; k < old->start[oi + 1]; k++)
+                    if (old->mesh[k] == tl->mesh[count] && old->tri[k] == t) {
+                        carry_entry(old, k, tl, count);
+                        break;
+                    }
+            count++;
+        }
+        start[i + 1] = count;
+    }
+    tl->count = count;
+    tl->n_rows = n;
+    return DEM_OK;
+}

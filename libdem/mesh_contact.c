@@ -1,0 +1,204 @@
+/* Sphere–mesh contacts: one contact per genuine touching point.
+ *
+ * Each candidate triangle gives its closest point q to the sphere centre p and the feature q
+ * lies on (face, edge, vertex). A touching triangle whose closest point is on an edge or
+ * vertex is kept only if no other touching triangle that contains the same edge or vertex is
+ * closer (by more than a round-off tolerance): then q is a local minimum of the distance over
+ * the surface, i.e. a real contact, not the rim of a face the sphere is already resting on.
+ * Contacts of one mesh at the same feature or within a round-off distance are merged. So a
+ * sphere on a flat region feels exactly the plane, whether above a face, an edge or a vertex
+ * shared by six triangles; at a convex edge or corner it feels the edge or corner once.
+ *
+ * Friction history lives in the (particle, triangle) entry; when a contact passes from one
+ * triangle to its neighbour (sliding across a seam), the new entry takes the history of the
+ * entry that just lost its contact, if their normals agree within 60 degrees. */
+#include "contact_law.h"
+#include "triangle.h"
+#include <math.h>
+#include <string.h>
+
+#define MAX_TOUCHING 64
+enum { FEATURE_FACE, FEATURE_EDGE, FEATURE_VERTEX };
+
+typedef struct touch {
+    int64_t k;       /* list entry */
+    double q[3];     /* closest point */
+    double dist;     /* |p - q| */
+    int kind;        /* FEATURE_* */
+    int32_t feature; /* triangle, edge or vertex id within the mesh */
+    int accepted;
+} touch;
+
+static int contains_feature(const mesh_wall *m, int32_t tri, int kind, int32_t id)
+{
+    const int32_t *ids = kind == FEATURE_EDGE ? m->tri_edge + 3 * tri : m->tri + 3 * tri;
+    return ids[0] == id || ids[1] == id || ids[2] == id;
+}
+
+/* The touching entries of particle i; returns their number, or -1 if more than fit. */
+static int find_touching(const dem_domain *d, int64_t i, touch *tc)
+{
+    const tri_list *tl = &d->tris_cur;
+    const double *p = d->x + 3 * i, r = d->radius[i];
+    int nt = 0;
+    for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) {
+        const mesh_wall *m = &d->meshes[tl->mesh[k]];
+        const int32_t t = tl->tri[k], *tv = m->tri + 3 * t;
+        double q[3];
+        int region = tri_closest_point(p, m->x + 3 * tv[0], m->x + 3 * tv[1], m->x + 3 * tv[2], q);
+        double d2 = tri_dist2(p, q);
+        if (d2 >= r * r) continue;
+        if (nt == MAX_TOUCHING) return -1;
+        touch *c = &tc[nt++];
+        c->k = k;
+        memcpy(c->q, q, sizeof q);
+        c->dist = sqrt(d2);
+        if (region == TRI_FACE) {
+            c->kind = FEATURE_FACE;
+            c->feature = t;
+        } else if (region <= TRI_EDGE_CA) {
+            c->kind = FEATURE_EDGE;
+            c->feature = m->tri_edge[3 * t + region - TRI_EDGE_AB];
+        } else {
+            c->kind = FEATURE_VERTEX;
+            c->feature = tv[region - TRI_VERT_A];
+        }
+        c->accepted = 1;
+    }
+    return nt;
+}
+
+/* Keep the local minima of the distance, merge duplicates (see the file comment). */
+static void select_contacts(const dem_domain *d, double r, touch *tc, int nt)
+{
+    const tri_list *tl = &d->tris_cur;
+    const double tol_d = 1e-10 * r;       /* distances equal within round-off */
+    const double tol_p = 2e-5 * r;        /* >= sqrt(2 r tol_d): points this close are one contact */
+    for (int a = 0; a < nt; a++) {
+        if (tc[a].kind == FEATURE_FACE) continue;
+        const int ma = tl->mesh[tc[a].k];
+        for (int b = 0; b < nt && tc[a].accepted; b++)
+            if (b != a && tl->mesh[tc[b].k] == ma && tc[b].dist < tc[a].dist - tol_d &&
+                contains_feature(&d->meshes[ma], tl->tri[tc[b].k], tc[a].kind, tc[a].feature))
+                tc[a].accepted = 0;
+    }
+    for (int a = 0; a < nt; a++) {
+        if (!tc[a].accepted) continue;
+        for (int b = 0; b < a && tc[a].accepted; b++) {
+            if (!tc[b].accepted || tl->mesh[tc[b].k] != tl->mesh[tc[a].k]) continue;
+            int same = (tc[a].kind == tc[b].kind && tc[a].feature == tc[b].feature) || tri_dist2(tc[a].q, tc[b].q) < tol_p * tol_p;
+            if (!same) continue;
+            if (tl->active[tc[a].k] && !tl->active[tc[b].k]) tc[b].accepted = 0; /* keep the one with history */
+            else tc[a].accepted = 0;
+        }
+    }
+}
+
+static void clear_entry(tri_list *tl, int64_t k)
+{
+    tl->active[k] = 0;
+    memset(tl->hist + 6 * k, 0, 6 * sizeof(double));
+    memset(tl->force + 3 * k, 0, 3 * sizeof(double));
+}
+
+void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad)
+{
+    tri_list *tl = &d->tris_cur;
+    const int64_t k0 = tl->start[i], k1 = tl->start[i + 1];
+    const double *p = d->x + 3 * i, *vi = d->v + 3 * i, *wi = d->w + 3 * i, r = d->radius[i];
+    touch tc[MAX_TOUCHING];
+    int nt = find_touching(d, i, tc);
+    if (nt < 0) {
+        if (i < *bad) *bad = i;
+        return;
+    }
+    select_contacts(d, r, tc, nt);
+    uint8_t keep[MAX_TOUCHING * 4];
+    const int64_t span = k1 - k0;
+    /* entries that keep a contact (for the spans we handle on the stack; longer lists are rare
+     * and simply skip the inheritance search bookkeeping below) */
+    for (int64_t k = 0; k < span && k < (int64_t)sizeof keep; k++) keep[k] = 0;
+    for (int a = 0; a < nt; a++)
+        if (tc[a].accepted && tc[a].k - k0 < (int64_t)sizeof keep) keep[tc[a].k - k0] = 1;
+
+    const pair_props *row_pairs = d->pairs + (size_t)d->mat[i] * d->n_materials;
+    for (int a = 0; a < nt; a++) {
+        if (!tc[a].accepted) continue;
+        const int64_t k = tc[a].k;
+        const mesh_wall *m = &d->meshes[tl->mesh[k]];
+        contact_in c;
+        const double inv = tc[a].dist > 1e-12 * r ? 1.0 / tc[a].dist : 0.0;
+        for (int b = 0; b < 3; b++) c.n[b] = (p[b] - tc[a].q[b]) * inv;
+        if (inv == 0.0) memcpy(c.n, m->normal + 3 * tl->tri[k], sizeof c.n); /* centre on the surface */
+        if (!tl->active[k] && span <= (int64_t)sizeof keep) { /* new here: take over a contact that just left */
+            int64_t best = -1;
+            double best_dot = 0.5;
+            for (int64_t o = k0; o < k1; o++) {
+                if (!tl->active[o] || keep[o - k0] || tl->mesh[o] != tl->mesh[k]) continue;
+                const double *no = tl->normal + 3 * o;
+                double dot = no[0] * c.n[0] + no[1] * c.n[1] + no[2] * c.n[2];
+                if (dot > best_dot) {
+                    best_dot = dot;
+                    best = o;
+                }
+            }
+            if (best >= 0) {
+                memcpy(tl->hist + 6 * k, tl->hist + 6 * best, 6 * sizeof(double));
+                clear_entry(tl, best);
+            }
+        }
+        c.overlap = r - tc[a].dist;
+        if (c.overlap > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
+        c.distance = tc[a].dist;
+        const double ci = r - 0.5 * c.overlap;
+        const double *q = tc[a].q, *om = m->omega;
+        double rel[3] = {q[0] - m->centre[0], q[1] - m->centre[1], q[2] - m->centre[2]};
+        double vw[3] = {m->velocity[0] + om[1] * rel[2] - om[2] * rel[1], m->velocity[1] + om[2] * rel[0] - om[0] * rel[2],
+                        m->velocity[2] + om[0] * rel[1] - om[1] * rel[0]};
+        c.vc[0] = vi[0] - vw[0] - ci * (wi[1] * c.n[2] - wi[2] * c.n[1]);
+        c.vc[1] = vi[1] - vw[1] - ci * (wi[2] * c.n[0] - wi[0] * c.n[2]);
+        c.vc[2] = vi[2] - vw[2] - ci * (wi[0] * c.n[1] - wi[1] * c.n[0]);
+        for (int b = 0; b < 3; b++) c.wrel[b] = wi[b] - om[b];
+        c.r_eff = r;
+        c.m_eff = 1.0 / d->inv_mass[i];
+        c.radius_i = r;
+        c.radius_j = 0.0;
+        c.inv_mass_i = d->inv_mass[i];
+        c.inv_mass_j = 0.0;
+        contact_out o;
+        contact_law(&row_pairs[m->material], &c, dt_hist, tl->hist + 6 * k, tl->hist + 6 * k + 3, &o);
+        for (int b = 0; b < 3; b++) {
+            f[b] += o.force[b];
+            t[b] += -ci * o.cross[b] + o.mr[b];
+            tl->force[3 * k + b] = o.force[b];
+            tl->point[3 * k + b] = q[b];
+            tl->normal[3 * k + b] = c.n[b];
+        }
+        tl->active[k] = 1;
+    }
+    /* entries without a contact now forget theirs */
+    for (int64_t k = k0; k < k1; k++) {
+        if (!tl->active[k]) continue;
+        int kept = 0;
+        for (int a = 0; a < nt && !kept; a++) kept = tc[a].accepted && tc[a].k == k;
+        if (!kept) clear_entry(tl, k);
+    }
+}
+
+/* Cold path: why particle i was flagged by dem_mesh_contacts. */
+dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i)
+{
+    touch tc[MAX_TOUCHING];
+    int nt = find_touching(d, i, tc);
+    if (nt < 0)
+        return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
+                        "step %lld: more than %d mesh triangles touch particle id %lld (radius %g m): the mesh is far "
+                        "finer than the particles, or the particle went through it",
+                        (long long)d->step + 1, MAX_TOUCHING, (long long)d->id[i], d->radius[i]);
+    int mesh = nt > 0 ? d->tris_cur.mesh[tc[0].k] : -1;
+    return dem_fail(d, DEM_ERR_RUNAWAY_OVERLAP,
+                    "runaway overlap during step %lld: particle id %lld overlaps mesh wall %d by more than %g of its "
+                    "radius (time step too large for the stiffness and speeds, or a wall moved into the particles too "
+                    "fast)",
+                    (long long)d->step + 1, (long long)d->id[i], mesh, d->def.max_overlap_ratio);
+}
