@@ -11,6 +11,7 @@
 #include "base.h"
 #include "types.h"
 #include "mesh.h"
+#include "stress.h"
 
 #ifdef __cplusplus
 extern "C" {
