@@ -13,8 +13,11 @@ BUILD   := build
 # ARCH_OPT= to build for any x86-64, e.g. for a library shipped to other machines.
 ARCH_OPT ?= $(shell grep -qw avx2 /proc/cpuinfo 2>/dev/null && $(CC) -march=x86-64-v3 -x c -c /dev/null -o /dev/null 2>/dev/null && echo -march=x86-64-v3)
 OPT     ?= -O3 -fno-math-errno -fno-trapping-math $(ARCH_OPT)
-CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem
-LDLIBS  += -lm
+# HDF5 (snapshots) and libpng (images), installed by scripts/setup.sh
+DEPS_CFLAGS := $(shell pkg-config --cflags hdf5-serial libpng 2>/dev/null)
+DEPS_LIBS   := $(shell pkg-config --libs hdf5-serial libpng 2>/dev/null || echo -lhdf5 -lpng)
+CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem $(DEPS_CFLAGS)
+LDLIBS  += $(DEPS_LIBS) -lm
 PYTHON  := .venv/bin/python
 
 LIB_SRC := $(wildcard libdem/*.c)
@@ -44,7 +47,7 @@ $(BUILD)/libdem.so: $(LIB_OBJ)
 # pkg-config file for PREFIX (rewritten whenever PREFIX differs from the last one)
 $(BUILD)/dem.pc: FORCE
 	@mkdir -p $(BUILD)
-	@printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nCflags: -I$${includedir}\n' \
+	@printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nRequires.private: hdf5-serial libpng\nCflags: -I$${includedir}\n' \
 	  "$(PREFIX)" "$$(sed -n 's/#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)" > $@.tmp
 	@cmp -s $@.tmp $@ || mv $@.tmp $@; rm -f $@.tmp
 

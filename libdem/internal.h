@@ -149,6 +149,8 @@ struct dem_domain {
     int need_rebuild;
     double r_max;             /* largest radius present */
 
+    uint64_t seed;            /* the caller's run seed, recorded in snapshots */
+
     /* time */
     int64_t step;
     double time;
@@ -193,6 +195,15 @@ dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i);
 /* mesh_bins.c: candidate triangles of every particle (called by the neighbour build) */
 dem_status dem_mesh_candidates(dem_domain *d);
 void dem_mesh_free_all(dem_domain *d);
+
+/* mesh.c: finishing a mesh from x_ref/tri (edges, world, normals; 0: out of memory), adding
+ * a finished mesh without the overlap check, freeing one */
+int dem_mesh_finish(mesh_wall *m);
+dem_status dem_mesh_append(dem_domain *d, mesh_wall *m, const char *what, int *out);
+void dem_mesh_free(mesh_wall *m);
+
+/* particles.c: room for n particles and ids below next_id (0: out of memory) */
+int dem_particles_reserve(dem_domain *d, int64_t n, int64_t next_id);
 
 /* mesh_motion.c: servo update from the forces of the step just computed, then the rigid
  * motion of every moving mesh over dt (keeps d->mesh_disp up to date) */

@@ -64,7 +64,7 @@ static void hmap_put(hmap *h, uint64_t s, int64_t a, int64_t b, int64_t c, int32
 }
 
 /* ---- building ------------------------------------------------------------------------ */
-static void free_mesh(mesh_wall *m)
+void dem_mesh_free(mesh_wall *m)
 {
     free(m->x_ref);
     free(m->x);
@@ -78,7 +78,7 @@ static void free_mesh(mesh_wall *m)
 
 void dem_mesh_free_all(dem_domain *d)
 {
-    for (int k = 0; k < d->n_meshes; k++) free_mesh(&d->meshes[k]);
+    for (int k = 0; k < d->n_meshes; k++) dem_mesh_free(&d->meshes[k]);
     free(d->meshes);
     free(d->tri_cell_start);
     free(d->tri_cell_mesh);
@@ -197,25 +197,36 @@ static dem_status build_mesh(dem_domain *d, const double *corner, int64_t n, dou
     }
     m->nv = used;
     m->x_ref = malloc((size_t)used * 3 * sizeof(double));
-    m->x = malloc((size_t)used * 3 * sizeof(double));
-    m->x_build = malloc((size_t)used * 3 * sizeof(double));
-    m->normal = malloc((size_t)nt * 3 * sizeof(double));
-    m->tri_edge = malloc((size_t)nt * 3 * sizeof(int32_t));
-    m->edge_ntri = malloc((size_t)nt * 3 * sizeof(int32_t)); /* at most 3 nt edges */
-    if (!m->x_ref || !m->x || !m->x_build || !m->normal || !m->tri_edge || !m->edge_ntri) {
+    if (!m->x_ref) {
         st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
         goto done;
     }
     for (int32_t v = 0; v < nv; v++)
         if (vmap[v] >= 0) memcpy(m->x_ref + 3 * vmap[v], vx + 3 * v, 3 * sizeof(double));
     for (int64_t k = 0; k < 3 * nt; k++) m->tri[k] = vmap[m->tri[k]];
+    if (!dem_mesh_finish(m)) st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
 
-    /* edges: (min, max) vertex pair -> id */
+done:
+    free(vmap);
+    free(next);
+    free(vx);
+    hmap_free(&cells);
+    if (st != DEM_OK) dem_mesh_free(m);
+    return st;
+}
+
+/* Given x_ref, tri, nv, nt: edges, world vertices, normals, identity pose. 0: no memory. */
+int dem_mesh_finish(mesh_wall *m)
+{
+    const int64_t nt = m->nt;
+    m->x = malloc((size_t)m->nv * 3 * sizeof(double));
+    m->x_build = malloc((size_t)m->nv * 3 * sizeof(double));
+    m->normal = malloc((size_t)nt * 3 * sizeof(double));
+    m->tri_edge = malloc((size_t)nt * 3 * sizeof(int32_t));
+    m->edge_ntri = malloc((size_t)nt * 3 * sizeof(int32_t)); /* at most 3 nt edges */
     hmap edges;
-    if (!hmap_init(&edges, 3 * nt)) {
-        st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
-        goto done;
-    }
+    if (!m->x || !m->x_build || !m->normal || !m->tri_edge || !m->edge_ntri || !hmap_init(&edges, 3 * nt)) return 0;
+    /* edges: (min, max) vertex pair -> id */
     int32_t ne = 0;
     for (int64_t t = 0; t < nt; t++)
         for (int e = 0; e < 3; e++) {
@@ -233,15 +244,8 @@ static dem_status build_mesh(dem_domain *d, const double *corner, int64_t n, dou
     m->ne = ne;
     for (int a = 0; a < 9; a++) m->rot[a] = (a % 4 == 0) ? 1.0 : 0.0;
     dem_mesh_update_world(m);
-    memcpy(m->x_build, m->x, (size_t)used * 3 * sizeof(double));
-
-done:
-    free(vmap);
-    free(next);
-    free(vx);
-    hmap_free(&cells);
-    if (st != DEM_OK) free_mesh(m);
-    return st;
+    memcpy(m->x_build, m->x, (size_t)m->nv * 3 * sizeof(double));
+    return 1;
 }
 
 /* Particle k (of n at x, r) that mesh m cuts, or -1. */
@@ -285,18 +289,14 @@ int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x
     return -1;
 }
 
-static dem_status add_built_mesh(dem_domain *d, mesh_wall *m, const char *what, int *out)
+/* Appends a finished mesh to the domain (takes its arrays, frees them on failure). */
+dem_status dem_mesh_append(dem_domain *d, mesh_wall *m, const char *what, int *out)
 {
-    int64_t cut = first_cut_particle(d, m, d->n, d->x, d->radius);
-    if (cut >= 0) {
-        free_mesh(m);
-        return dem_fail(d, DEM_ERR_OVERLAP, "%s: the mesh cuts particle id %lld", what, (long long)d->id[cut]);
-    }
     if (d->n_meshes == d->cap_meshes) {
         int c = d->cap_meshes ? 2 * d->cap_meshes : 4;
         mesh_wall *p = dem_realloc_array(d->meshes, (size_t)c, sizeof *p);
         if (!p) {
-            free_mesh(m);
+            dem_mesh_free(m);
             return dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
         }
         d->meshes = p;
@@ -304,11 +304,22 @@ static dem_status add_built_mesh(dem_domain *d, mesh_wall *m, const char *what, 
     }
     d->meshes[d->n_meshes] = *m;
     *out = d->n_meshes++;
+    for (int k = 0; k < d->n_meshes; k++) d->meshes[k].binned = 0; /* the bins must list it */
     d->need_rebuild = 1;
     d->forces_valid = 0;
     d->rayleigh_cache = -1.0;
     dem_clear_error(d);
     return DEM_OK;
+}
+
+static dem_status add_built_mesh(dem_domain *d, mesh_wall *m, const char *what, int *out)
+{
+    int64_t cut = first_cut_particle(d, m, d->n, d->x, d->radius);
+    if (cut >= 0) {
+        dem_mesh_free(m);
+        return dem_fail(d, DEM_ERR_OVERLAP, "%s: the mesh cuts particle id %lld", what, (long long)d->id[cut]);
+    }
+    return dem_mesh_append(d, m, what, out);
 }
 
 static dem_status check_def(dem_domain *d, const dem_mesh_def *def, const char *fn)

@@ -34,6 +34,11 @@ static int reserve_ids(dem_domain *d, int64_t need)
     return 1;
 }
 
+int dem_particles_reserve(dem_domain *d, int64_t n, int64_t next_id)
+{
+    return reserve_particles(d, n) && reserve_ids(d, next_id);
+}
+
 /* Index of the first particle (existing or new) that overlaps another one by more than
  * insert_overlap_ratio of the smaller radius; fills *other. Uses a temporary cell grid. */
 static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, const double *rad, int64_t *other,

@@ -12,6 +12,7 @@
 #include "types.h"
 #include "mesh.h"
 #include "stress.h"
+#include "io.h"
 
 #ifdef __cplusplus
 extern "C" {
