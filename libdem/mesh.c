@@ -248,33 +248,82 @@ int dem_mesh_finish(mesh_wall *m)
     return 1;
 }
 
-/* Particle k (of n at x, r) that mesh m cuts, or -1. */
+/* Particle k (of n at x, r) that mesh m cuts, or -1. The particles are hashed into a grid
+ * of cells of the largest diameter; each triangle checks the cells its inflated box covers. */
 static int64_t first_cut_particle(const dem_domain *d, const mesh_wall *m, int64_t n, const double *x, const double *r)
 {
-    double lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = INFINITY;
-        hi[a] = -INFINITY;
-    }
-    for (int64_t v = 0; v < m->nv; v++)
-        for (int a = 0; a < 3; a++) {
-            if (m->x[3 * v + a] < lo[a]) lo[a] = m->x[3 * v + a];
-            if (m->x[3 * v + a] > hi[a]) hi[a] = m->x[3 * v + a];
-        }
-    const double keep = 1.0 - d->def.insert_overlap_ratio;
+    if (n == 0) return -1;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, rmax = 0.0;
     for (int64_t i = 0; i < n; i++) {
-        const double *p = x + 3 * i;
-        int near = 1;
-        for (int a = 0; a < 3; a++) near &= (p[a] > lo[a] - r[i]) & (p[a] < hi[a] + r[i]);
-        if (!near) continue;
-        for (int64_t t = 0; t < m->nt; t++) {
-            const int32_t *tv = m->tri + 3 * t;
-            double q[3];
-            tri_closest_point(p, m->x + 3 * tv[0], m->x + 3 * tv[1], m->x + 3 * tv[2], q);
-            if (tri_dist2(p, q) < keep * keep * r[i] * r[i]) return i;
+        rmax = fmax(rmax, r[i]);
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], x[3 * i + a]);
+            hi[a] = fmax(hi[a], x[3 * i + a]);
         }
     }
-    return -1;
+    int nc[3];
+    double cs = 2.0 * rmax;
+    for (;;) { /* at most ~2 cells per particle */
+        int64_t total = 1;
+        for (int a = 0; a < 3; a++) {
+            double c = floor((hi[a] - lo[a]) / cs) + 1.0;
+            nc[a] = c > 1e6 ? 1000000 : (int)c;
+            total *= nc[a];
+        }
+        if (total <= 2 * n + 64) break;
+        cs *= 1.5;
+    }
+    int64_t ncell = (int64_t)nc[0] * nc[1] * nc[2];
+    int64_t *head = malloc((size_t)ncell * sizeof *head), *next = malloc((size_t)n * sizeof *next);
+    if (!head || !next) { /* no memory for the grid: check everything */
+        free(head);
+        free(next);
+        head = NULL;
+    }
+    int64_t found = -1;
+    const double keep = 1.0 - d->def.insert_overlap_ratio;
+#define CELL(i_, a_) ((int)fmin(fmax(floor((x[3 * (i_) + (a_)] - lo[(a_)]) / cs), 0.0), nc[(a_)] - 1.0))
+    if (head) {
+        for (int64_t c = 0; c < ncell; c++) head[c] = -1;
+        for (int64_t i = n - 1; i >= 0; i--) {
+            int64_t c = ((int64_t)CELL(i, 2) * nc[1] + CELL(i, 1)) * nc[0] + CELL(i, 0);
+            next[i] = head[c];
+            head[c] = i;
+        }
+    }
+    for (int64_t t = 0; t < m->nt && found < 0; t++) {
+        const int32_t *tv = m->tri + 3 * t;
+        const double *A = m->x + 3 * tv[0], *B = m->x + 3 * tv[1], *C = m->x + 3 * tv[2];
+        int c0[3], c1[3];
+        int outside = 0;
+        for (int a = 0; a < 3; a++) {
+            double tlo = fmin(A[a], fmin(B[a], C[a])) - rmax, thi = fmax(A[a], fmax(B[a], C[a])) + rmax;
+            if (thi < lo[a] || tlo > hi[a]) outside = 1;
+            c0[a] = (int)fmax(floor((tlo - lo[a]) / cs), 0.0);
+            c1[a] = (int)fmin(floor((thi - lo[a]) / cs), nc[a] - 1.0);
+        }
+        if (outside) continue;
+        if (!head) { /* fallback: every particle */
+            for (int64_t i = 0; i < n && found < 0; i++) {
+                double q[3];
+                tri_closest_point(x + 3 * i, A, B, C, q);
+                if (tri_dist2(x + 3 * i, q) < keep * keep * r[i] * r[i]) found = i;
+            }
+            continue;
+        }
+        for (int cz = c0[2]; cz <= c1[2]; cz++)
+            for (int cy = c0[1]; cy <= c1[1]; cy++)
+                for (int cx = c0[0]; cx <= c1[0]; cx++)
+                    for (int64_t i = head[((int64_t)cz * nc[1] + cy) * nc[0] + cx]; i >= 0; i = next[i]) {
+                        double q[3];
+                        tri_closest_point(x + 3 * i, A, B, C, q);
+                        if (tri_dist2(x + 3 * i, q) < keep * keep * r[i] * r[i] && (found < 0 || i < found)) found = i;
+                    }
+    }
+#undef CELL
+    free(head);
+    free(next);
+    return found;
 }
 
 int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x, const double *r, int *which_mesh)
