@@ -30,6 +30,23 @@ static inline void grid_rectangle(double x0, double x1, double y0, double y1, do
         }
 }
 
+/* Adds grid_rectangle(...) as a mesh wall of the given material; returns its index. */
+static inline int add_grid_mesh(dem_domain *d, double x0, double x1, double y0, double y1, double z, int nx, int ny,
+                                int material)
+{
+    double *v;
+    int32_t *t;
+    int64_t nv, nt;
+    grid_rectangle(x0, x1, y0, y1, z, nx, ny, &v, &nv, &t, &nt);
+    dem_mesh_def md = dem_default_mesh_def();
+    md.material = material;
+    int mesh = -1;
+    assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &mesh));
+    free(v);
+    free(t);
+    return mesh;
+}
+
 /* An open box (floor + four sides, no lid) [0, L] x [0, L] x [0, H] as one mesh; each face
  * split into n x n squares (n = 1: two triangles per face). */
 static inline int add_open_box(dem_domain *d, double L, double H, int n, int material)

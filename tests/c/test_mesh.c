@@ -21,16 +21,7 @@ static drop run_drop(int mesh_n, double x, double y, double e, double mu)
         pw.material = mat;
         assert_ok(dem_plane_wall_add(d, &pw, &w));
     } else {
-        double *v;
-        int32_t *t;
-        int64_t nv, nt;
-        grid_rectangle(0, 0.01, 0, 0.01, 0, mesh_n, mesh_n, &v, &nv, &t, &nt);
-        dem_mesh_def md = dem_default_mesh_def();
-        md.material = mat;
-        int m;
-        assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &m));
-        free(v);
-        free(t);
+        add_grid_mesh(d, 0, 0.01, 0, 0.01, 0, mesh_n, mesh_n, mat);
     }
     double pos[3] = {x, y, R + 1e-6}, vel[3] = {0.1, 0.05, -0.5}; /* oblique: friction acts too */
     assert_ok(dem_particles_add(d, 1, pos, (double[]){R}, &mat, vel, NULL, NULL));
@@ -90,16 +81,7 @@ static void roll(int mesh, double out[6], int *max_contacts)
     double g[3] = {0, 0, -9.81};
     assert_ok(dem_domain_set_gravity(d, g));
     if (mesh) {
-        double *v;
-        int32_t *t;
-        int64_t nv, nt;
-        grid_rectangle(0, 0.04, 0, 0.04, 0, 32, 32, &v, &nv, &t, &nt); /* 1.25 mm squares */
-        dem_mesh_def md = dem_default_mesh_def();
-        md.material = mat;
-        int m;
-        assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &m));
-        free(v);
-        free(t);
+        add_grid_mesh(d, 0, 0.04, 0, 0.04, 0, 32, 32, mat); /* 1.25 mm squares */
     } else {
         int w;
         dem_plane_wall_def pw = dem_default_plane_wall_def();
@@ -149,16 +131,7 @@ static void test_moving_mesh_belt(void **state)
     assert_non_null(d);
     double g[3] = {0, 0, -9.81};
     assert_ok(dem_domain_set_gravity(d, g));
-    double *v;
-    int32_t *t;
-    int64_t nv, nt;
-    grid_rectangle(0.0, 0.04, 0, 0.04, 0, 8, 8, &v, &nv, &t, &nt);
-    dem_mesh_def md = dem_default_mesh_def();
-    md.material = mat;
-    int m;
-    assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &m));
-    free(v);
-    free(t);
+    int m = add_grid_mesh(d, 0.0, 0.04, 0, 0.04, 0, 8, 8, mat);
     double pos[3] = {0.02, 0.02, R - 5e-7};
     assert_ok(dem_particles_add(d, 1, pos, (double[]){R}, &mat, NULL, NULL, NULL));
     assert_ok(dem_domain_step(d, 5000)); /* come to rest */
@@ -180,15 +153,12 @@ static void test_rotation_pose(void **state)
     (void)state;
     int mat;
     dem_domain *d = make_domain(0.04, 1e-5, E, 0.5, 0.3, &mat);
-    double *v;
-    int32_t *t;
-    int64_t nv, nt;
-    grid_rectangle(0.01, 0.03, 0.01, 0.03, 0.02, 2, 2, &v, &nv, &t, &nt);
-    dem_mesh_def md = dem_default_mesh_def();
-    md.material = mat;
-    int m;
-    assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &m));
-    assert_ok(dem_mesh_wall_get_vertices(d, m, v)); /* welding renumbers the vertices */
+    int m = add_grid_mesh(d, 0.01, 0.03, 0.01, 0.03, 0.02, 2, 2, mat);
+    dem_mesh_info info;
+    assert_ok(dem_mesh_wall_info(d, m, &info));
+    const int64_t nv = info.vertex_count;
+    double *v = malloc((size_t)nv * 3 * sizeof(double));
+    assert_ok(dem_mesh_wall_get_vertices(d, m, v)); /* before the motion */
     double axis[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)}, w = 2.0, c[3] = {0.02, 0.02, 0.02};
     double om[3] = {w * axis[0], w * axis[1], w * axis[2]};
     assert_ok(dem_mesh_wall_set_motion(d, m, (double[]){0, 0, 0}, om, c));
@@ -212,7 +182,6 @@ static void test_rotation_pose(void **state)
     assert_true(err < 1e-12); /* 1000 compositions of a re-orthonormalised rotation */
     free(x);
     free(v);
-    free(t);
     dem_domain_destroy(d);
 }
 

@@ -63,15 +63,7 @@ static dem_domain *rich_run(int *lid)
     assert_ok(dem_particles_get_positions(d, x));
     assert_ok(dem_particles_get_radii(d, r));
     for (int k = 0; k < 216; k++) top = fmax(top, x[3 * k + 2] + r[k]);
-    double *v;
-    int32_t *t;
-    int64_t nv, nt;
-    grid_rectangle(0.0005, 0.0095, 0.0005, 0.0095, top + 2e-4, 3, 3, &v, &nv, &t, &nt);
-    dem_mesh_def mdf = dem_default_mesh_def();
-    mdf.material = mw;
-    assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &mdf, lid));
-    free(v);
-    free(t);
+    *lid = add_grid_mesh(d, 0.0005, 0.0095, 0.0005, 0.0095, top + 2e-4, 3, 3, mw);
     assert_ok(dem_mesh_wall_set_motion(d, *lid, (double[]){0, 0, 0}, (double[]){0, 0, 3.0}, (double[]){0.005, 0.005, top}));
     dem_servo_def sd = dem_default_servo_def();
     sd.target_force = 0.05;

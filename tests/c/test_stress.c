@@ -107,16 +107,7 @@ static void test_servo_lid_and_region_stress(void **state)
     double x[3 * 200], zmax = 0.0;
     assert_ok(dem_particles_get_positions(d, x));
     for (int64_t i = 0; i < n; i++) zmax = fmax(zmax, x[3 * i + 2]);
-    double *v;
-    int32_t *t;
-    int64_t nv, nt;
-    grid_rectangle(0, L, 0, L, zmax + R + 2e-4, 2, 2, &v, &nv, &t, &nt);
-    dem_mesh_def md = dem_default_mesh_def();
-    md.material = mat;
-    int lid;
-    assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &lid));
-    free(v);
-    free(t);
+    int lid = add_grid_mesh(d, 0, L, 0, L, zmax + R + 2e-4, 2, 2, mat);
     const double sigma = 2000.0, area = L * L; /* 72 mN, ~30 x the column's weight */
     dem_servo_def sd = dem_default_servo_def();
     sd.target_stress = sigma;
