@@ -82,7 +82,7 @@ $(BUILD)/readme_example: README.md $(BUILD)/libdem.a
 test-py:
 	@if [ -d tests/py ]; then $(PYTHON) -m pytest -q tests/py; else echo "(no Python tests yet)"; fi
 
-$(BUILD)/bench/%: bench/%.c $(BUILD)/libdem.a
+$(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a $(LDLIBS)
 

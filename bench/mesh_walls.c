@@ -10,13 +10,14 @@
  *   mesh_walls [--settle 20000] [--steps 5000] [--repeat 3] [--csv FILE] [--png FILE] [--h5 FILE] */
 #define _POSIX_C_SOURCE 200809L
 #include "dem/dem.h"
+#include "lattice.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
-static const double W = 0.040, SPACING = 2.2e-3, RADIUS = 1e-3;
+static const double W = 0.040;
 static const int NSIDE = 18, NZ = 62;
 
 static double now_s(void)
@@ -63,7 +64,7 @@ static dem_domain *build(int variant, int *n_triangles)
     dem_domain_def def = dem_default_domain_def();
     def.lo[0] = def.lo[1] = def.lo[2] = 0.0;
     def.hi[0] = def.hi[1] = W;
-    def.hi[2] = 1.1e-3 + NZ * SPACING + 0.01;
+    def.hi[2] = 1.1e-3 + NZ * LATTICE_SPACING + 0.01;
     def.dt = 1e-5;
     def.skin = 2e-4;
     def.num_threads = 2;
@@ -106,20 +107,9 @@ static dem_domain *build(int variant, int *n_triangles)
         free(V);
         free(T);
     }
-    const int64_t n = (int64_t)NSIDE * NSIDE * NZ;
-    double *pos = malloc(sizeof(double) * 3 * n), *vel = malloc(sizeof(double) * 3 * n), *rad = malloc(sizeof(double) * n);
-    int *mats = malloc(sizeof(int) * n);
-    uint64_t rng = 42;
-    for (int64_t k = 0; k < n; k++) {
-        int64_t c[3] = {k % NSIDE, (k / NSIDE) % NSIDE, k / ((int64_t)NSIDE * NSIDE)};
-        for (int a = 0; a < 3; a++) {
-            rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
-            pos[3 * k + a] = 1.1e-3 + SPACING * (double)c[a];
-            vel[3 * k + a] = ((double)(rng >> 11) / 9007199254740992.0 - 0.5) * 0.1;
-        }
-        rad[k] = RADIUS;
-        mats[k] = mat;
-    }
+    double *pos, *vel, *rad;
+    int *mats;
+    const int64_t n = lattice(NSIDE, NZ, mat, &pos, &vel, &rad, &mats);
     check(d, dem_particles_add(d, n, pos, rad, mats, vel, NULL, NULL), "particles");
     free(pos);
     free(vel);

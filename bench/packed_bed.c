@@ -14,6 +14,7 @@
  * for quick profiling, the committed results settle from the lattice. */
 #define _POSIX_C_SOURCE 200809L
 #include "dem/dem.h"
+#include "lattice.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -103,7 +104,7 @@ int main(int argc, char **argv)
         }
     }
     const int nz = 62;
-    const double spacing = 2.2e-3, radius = 1e-3;
+    const double spacing = LATTICE_SPACING;
     dem_status s;
     dem_domain_def def = dem_default_domain_def();
     def.lo[0] = def.lo[1] = def.lo[2] = 0.0;
@@ -115,21 +116,9 @@ int main(int argc, char **argv)
     if (load) def.insert_overlap_ratio = 0.2; /* settled spheres touch: accept their overlaps */
     int mat;
     dem_domain *d = build_domain(&def, mu_r, &mat);
-    const int64_t n = (int64_t)n_side * n_side * nz;
-    double *pos = malloc(sizeof(double) * 3 * n), *vel = malloc(sizeof(double) * 3 * n);
-    double *rad = malloc(sizeof(double) * n);
-    int *mats = malloc(sizeof(int) * n);
-    uint64_t rng = 42;
-    for (int64_t k = 0; k < n; k++) {
-        int64_t c[3] = {k % n_side, (k / n_side) % n_side, k / ((int64_t)n_side * n_side)};
-        for (int a = 0; a < 3; a++) {
-            rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
-            pos[3 * k + a] = 1.1e-3 + spacing * (double)c[a];
-            vel[3 * k + a] = ((double)(rng >> 11) / 9007199254740992.0 - 0.5) * 0.1;
-        }
-        rad[k] = radius;
-        mats[k] = mat;
-    }
+    double *pos, *vel, *rad;
+    int *mats;
+    const int64_t n = lattice(n_side, nz, mat, &pos, &vel, &rad, &mats);
     double *angvel = calloc((size_t)(3 * n), sizeof(double));
     if (load) {
         FILE *f = fopen(load, "rb");

@@ -50,6 +50,29 @@ DEM_INLINE void vec_project_keep_length(double *h, const double *n)
     h[2] *= s;
 }
 
+/* A sphere (radius r, inverse mass im, velocity v, angular velocity w) against a wall surface
+ * that moves at vw and turns at ww: the contact for the unit normal n (towards the sphere) at
+ * centre-to-surface distance dist. Returns the sphere's lever arm r - overlap/2. */
+DEM_INLINE double wall_contact_in(contact_in *c, const double *n, double dist, double r, double im, const double *v,
+                                  const double *w, const double *vw, const double *ww)
+{
+    for (int a = 0; a < 3; a++) c->n[a] = n[a];
+    c->overlap = r - dist;
+    c->distance = dist;
+    const double ci = r - 0.5 * c->overlap;
+    c->vc[0] = v[0] - vw[0] - ci * (w[1] * n[2] - w[2] * n[1]);
+    c->vc[1] = v[1] - vw[1] - ci * (w[2] * n[0] - w[0] * n[2]);
+    c->vc[2] = v[2] - vw[2] - ci * (w[0] * n[1] - w[1] * n[0]);
+    for (int a = 0; a < 3; a++) c->wrel[a] = w[a] - ww[a];
+    c->r_eff = r;
+    c->m_eff = 1.0 / im;
+    c->radius_i = r;
+    c->radius_j = 0.0;
+    c->inv_mass_i = im;
+    c->inv_mass_j = 0.0;
+    return ci;
+}
+
 /* xi: tangential spring (3), mr_hist: rolling torque history (3), both updated in place. */
 DEM_INLINE void contact_law(const pair_props *pp, const contact_in *c, double dt, double *xi,
                                double *mr_hist, contact_out *out)

@@ -55,23 +55,10 @@ void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
             wf[0] = wf[1] = wf[2] = 0.0;
             continue;
         }
+        static const double no_spin[3] = {0.0, 0.0, 0.0};
         contact_in c;
-        for (int a = 0; a < 3; a++) c.n[a] = pw->normal[a];
-        c.overlap = ri - dist;
+        const double ci = wall_contact_in(&c, pw->normal, dist, ri, d->inv_mass[i], vi, wi, pw->def.velocity, no_spin);
         if (c.overlap > d->def.max_overlap_ratio * ri && i < *bad) *bad = i;
-        c.distance = dist;
-        const double ci = ri - 0.5 * c.overlap;
-        const double *vw = pw->def.velocity;
-        c.vc[0] = vi[0] - vw[0] - ci * (wi[1] * c.n[2] - wi[2] * c.n[1]);
-        c.vc[1] = vi[1] - vw[1] - ci * (wi[2] * c.n[0] - wi[0] * c.n[2]);
-        c.vc[2] = vi[2] - vw[2] - ci * (wi[0] * c.n[1] - wi[1] * c.n[0]);
-        for (int a = 0; a < 3; a++) c.wrel[a] = wi[a];
-        c.r_eff = ri;
-        c.m_eff = 1.0 / d->inv_mass[i];
-        c.radius_i = ri;
-        c.radius_j = 0.0;
-        c.inv_mass_i = d->inv_mass[i];
-        c.inv_mass_j = 0.0;
         contact_out o;
         contact_law(&row_pairs[pw->def.material], &c, dt_hist, hxi, hmr, &o);
         for (int a = 0; a < 3; a++) {

@@ -129,17 +129,17 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         if (!tc[a].accepted) continue;
         const int64_t k = tc[a].k;
         const mesh_wall *m = &d->meshes[tl->mesh[k]];
-        contact_in c;
+        double n[3]; /* from the surface point to the centre */
         const double inv = tc[a].dist > 1e-12 * r ? 1.0 / tc[a].dist : 0.0;
-        for (int b = 0; b < 3; b++) c.n[b] = (p[b] - tc[a].q[b]) * inv;
-        if (inv == 0.0) memcpy(c.n, m->normal + 3 * tl->tri[k], sizeof c.n); /* centre on the surface */
+        for (int b = 0; b < 3; b++) n[b] = (p[b] - tc[a].q[b]) * inv;
+        if (inv == 0.0) memcpy(n, m->normal + 3 * tl->tri[k], sizeof n); /* centre on the surface */
         if (!tl->active[k] && span <= (int64_t)sizeof keep) { /* new here: take over a contact that just left */
             int64_t best = -1;
             double best_dot = 0.5;
             for (int64_t o = k0; o < k1; o++) {
                 if (!tl->active[o] || keep[o - k0] || tl->mesh[o] != tl->mesh[k]) continue;
                 const double *no = tl->normal + 3 * o;
-                double dot = no[0] * c.n[0] + no[1] * c.n[1] + no[2] * c.n[2];
+                double dot = no[0] * n[0] + no[1] * n[1] + no[2] * n[2];
                 if (dot > best_dot) {
                     best_dot = dot;
                     best = o;
@@ -150,24 +150,13 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
                 clear_entry(tl, best);
             }
         }
-        c.overlap = r - tc[a].dist;
-        if (c.overlap > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
-        c.distance = tc[a].dist;
-        const double ci = r - 0.5 * c.overlap;
-        const double *q = tc[a].q, *om = m->omega;
+        const double *q = tc[a].q, *om = m->omega; /* surface velocity v + w x (q - c) */
         double rel[3] = {q[0] - m->centre[0], q[1] - m->centre[1], q[2] - m->centre[2]};
         double vw[3] = {m->velocity[0] + om[1] * rel[2] - om[2] * rel[1], m->velocity[1] + om[2] * rel[0] - om[0] * rel[2],
                         m->velocity[2] + om[0] * rel[1] - om[1] * rel[0]};
-        c.vc[0] = vi[0] - vw[0] - ci * (wi[1] * c.n[2] - wi[2] * c.n[1]);
-        c.vc[1] = vi[1] - vw[1] - ci * (wi[2] * c.n[0] - wi[0] * c.n[2]);
-        c.vc[2] = vi[2] - vw[2] - ci * (wi[0] * c.n[1] - wi[1] * c.n[0]);
-        for (int b = 0; b < 3; b++) c.wrel[b] = wi[b] - om[b];
-        c.r_eff = r;
-        c.m_eff = 1.0 / d->inv_mass[i];
-        c.radius_i = r;
-        c.radius_j = 0.0;
-        c.inv_mass_i = d->inv_mass[i];
-        c.inv_mass_j = 0.0;
+        contact_in c;
+        const double ci = wall_contact_in(&c, n, tc[a].dist, r, d->inv_mass[i], vi, wi, vw, om);
+        if (c.overlap > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
         contact_out o;
         contact_law(&row_pairs[m->material], &c, dt_hist, tl->hist + 6 * k, tl->hist + 6 * k + 3, &o);
         for (int b = 0; b < 3; b++) {
@@ -175,7 +164,7 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
             t[b] += -ci * o.cross[b] + o.mr[b];
             tl->force[3 * k + b] = o.force[b];
             tl->point[3 * k + b] = q[b];
-            tl->normal[3 * k + b] = c.n[b];
+            tl->normal[3 * k + b] = n[b];
         }
         tl->active[k] = 1;
     }

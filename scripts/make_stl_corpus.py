@@ -10,6 +10,8 @@ import random
 import struct
 from pathlib import Path
 
+from make_geometry import ascii_stl
+
 OUT = Path(__file__).resolve().parent.parent / "tests" / "data" / "stl_corpus"
 
 CUBE = [  # 12 triangles of the unit cube
@@ -20,16 +22,6 @@ CUBE = [  # 12 triangles of the unit cube
     ((0, 0, 0), (0, 0, 1), (0, 1, 1)), ((0, 0, 0), (0, 1, 1), (0, 1, 0)),
     ((1, 0, 0), (1, 1, 0), (1, 1, 1)), ((1, 0, 0), (1, 1, 1), (1, 0, 1)),
 ]
-
-
-def ascii_stl(tris, name="cube"):
-    lines = [f"solid {name}"]
-    for t in tris:
-        lines += ["  facet normal 0 0 0", "    outer loop"]
-        lines += [f"      vertex {v[0]} {v[1]} {v[2]}" for v in t]
-        lines += ["    endloop", "  endfacet"]
-    lines.append(f"endsolid {name}")
-    return ("\n".join(lines) + "\n").encode()
 
 
 def binary_stl(tris, header=b"binary cube"):
@@ -66,7 +58,7 @@ def main():
     for f in OUT.glob("*.stl"):
         f.unlink()
     rng = random.Random(20261121)
-    a, b = ascii_stl(CUBE), binary_stl(CUBE)
+    a, b = ascii_stl("cube", CUBE).encode(), binary_stl(CUBE)
     files = {
         "seed_ascii_cube.stl": a,
         "seed_binary_cube.stl": b,
@@ -81,7 +73,7 @@ def main():
         "missing_endsolid.stl": a.replace(b"endsolid cube\n", b""),
         "junk_token.stl": a.replace(b"outer loop", b"outer lop", 1),
         "short_header.stl": b"\0" * 50,
-        "all_degenerate.stl": ascii_stl([((0, 0, 0), (1, 1, 1), (2, 2, 2)), ((0, 0, 0), (0, 0, 0), (1, 0, 0))]),
+        "all_degenerate.stl": ascii_stl("degenerate", [((0, 0, 0), (1, 1, 1), (2, 2, 2)), ((0, 0, 0), (0, 0, 0), (1, 0, 0))]).encode(),
         "nul_in_ascii.stl": a[:100] + b"\0" + a[101:],
     }
     for k, m in enumerate(mutations(a, rng, 20)):
