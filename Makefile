@@ -28,9 +28,9 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib setup test test-c test-sanitize test-py bench demo install clean FORCE
+.PHONY: all lib pydem setup test test-c test-sanitize test-py bench demo install clean FORCE
 
-all: lib
+all: lib pydem
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
 
 $(BUILD)/obj/%.o: libdem/%.c $(HEADERS)
@@ -79,8 +79,15 @@ $(BUILD)/readme_example: README.md $(BUILD)/libdem.a
 	sed -n '/^```c readme-example/,/^```/p' README.md | sed '1d;$$d' > $(BUILD)/readme_example.c
 	$(CC) $(CFLAGS) $(BUILD)/readme_example.c -o $@ $(BUILD)/libdem.a $(LDLIBS)
 
-test-py:
-	@if [ -d tests/py ]; then $(PYTHON) -m pytest -q tests/py; else echo "(no Python tests yet)"; fi
+# the Python binding (cffi, API mode) over the headers and the static library
+PYDEM_STAMP := $(BUILD)/pydem.stamp
+pydem: $(PYDEM_STAMP)
+$(PYDEM_STAMP): $(BUILD)/libdem.a $(wildcard include/dem/*.h) pydem/_build_ffi.py
+	$(PYTHON) pydem/_build_ffi.py
+	@touch $@
+
+test-py: pydem
+	$(PYTHON) -m pytest -q tests/py
 
 $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
@@ -92,7 +99,7 @@ bench: setup lib $(BENCH_BIN)
 demo: setup lib $(BUILD)/bench/packed_bed
 	$(BUILD)/bench/packed_bed --demo
 
-install: lib
+install: lib pydem
 	install -d $(DESTDIR)$(PREFIX)/include/dem $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 include/dem/*.h $(DESTDIR)$(PREFIX)/include/dem/
 	install -m 644 $(BUILD)/libdem.a $(BUILD)/libdem.so $(DESTDIR)$(PREFIX)/lib/

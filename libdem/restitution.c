@@ -43,9 +43,8 @@ double dem_restitution_for_damping_factor(double factor)
     return 0.0;
 }
 
-double dem_damping_factor_for_restitution(double e)
+static double invert(double e)
 {
-    if (e >= 1.0) return 0.0;
     /* e(c) decreases monotonically from 1 (c = 0) towards 0 (c -> infinity) */
     double lo = 0.0, hi = 1.0;
     while (dem_restitution_for_damping_factor(hi) > e && hi < 1e6) hi *= 2.0;
@@ -55,4 +54,30 @@ double dem_damping_factor_for_restitution(double e)
         else hi = mid;
     }
     return 0.5 * (lo + hi);
+}
+
+/* The inversion costs ~30 ms; campaigns create many domains with the same few restitution
+ * values, so results are kept in a small process-wide cache (exact match on e). The critical
+ * section makes it safe for concurrent domains on different threads. */
+#define CACHE_SIZE 64
+static double cache_e[CACHE_SIZE], cache_factor[CACHE_SIZE];
+static int cache_count, cache_next;
+
+double dem_damping_factor_for_restitution(double e)
+{
+    if (e >= 1.0) return 0.0;
+    double factor = -1.0;
+#pragma omp critical(dem_restitution_cache)
+    for (int k = 0; k < cache_count; k++)
+        if (cache_e[k] == e) factor = cache_factor[k];
+    if (factor >= 0.0) return factor;
+    factor = invert(e);
+#pragma omp critical(dem_restitution_cache)
+    {
+        cache_e[cache_next] = e;
+        cache_factor[cache_next] = factor;
+        cache_next = (cache_next + 1) % CACHE_SIZE;
+        if (cache_count < CACHE_SIZE) cache_count++;
+    }
+    return factor;
 }

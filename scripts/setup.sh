@@ -4,7 +4,7 @@
 set -e
 cd "$(dirname "$0")/.."
 
-SYS_PKGS="libhdf5-dev libpng-dev libcmocka-dev pkg-config"
+SYS_PKGS="libhdf5-dev libpng-dev libcmocka-dev pkg-config valgrind"
 missing=""
 for p in $SYS_PKGS; do
     dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
@@ -28,4 +28,11 @@ if [ ! -f "$STAMP" ] || ! cmp -s "$REQ" "$STAMP"; then
     .venv/bin/python -m pip install -q --upgrade pip
     .venv/bin/python -m pip install -q -r "$REQ"
     cp "$REQ" "$STAMP"
+fi
+# `import pydem` from anywhere with .venv/bin/python, and a `pydem` command
+SITE=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+[ -f "$SITE/pydem-repo.pth" ] || pwd > "$SITE/pydem-repo.pth"
+if [ ! -x .venv/bin/pydem ]; then
+    printf '#!/bin/sh\nexec "$(dirname "$0")/python" -m pydem "$@"\n' > .venv/bin/pydem
+    chmod +x .venv/bin/pydem
 fi

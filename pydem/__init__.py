@@ -1,0 +1,31 @@
+"""pydem — the Python front-end of libdem: numpy in and out, the lab-test rigs, a command line.
+
+    import pydem
+    dom = pydem.Domain(lo=(0, 0, 0), hi=(0.1, 0.1, 0.1))
+"""
+__version__ = "0.1.0"
+
+try:
+    from ._libdem import ffi as _ffi, lib as _lib
+except ImportError as exc:  # the compiled binding is built by `make pydem`
+    raise ImportError(f"pydem's compiled binding is missing or broken ({exc}); run `make pydem` in the repository") from exc
+
+
+def _check_versions():
+    runtime = _ffi.string(_lib.dem_version_string()).decode()
+    header = f"{_lib.DEM_VERSION_MAJOR}.{_lib.DEM_VERSION_MINOR}.{_lib.DEM_VERSION_PATCH}"
+    if runtime != header or runtime.split(".")[:2] != __version__.split(".")[:2]:
+        raise ImportError(
+            f"version mismatch: libdem {runtime} (headers {header}) vs pydem {__version__}; rebuild with `make pydem`")
+    return runtime
+
+
+LIBDEM_VERSION = _check_versions()
+
+from .errors import (DemError, DemFormatError, DemInvalidArgument, DemIOError, DemOverlapError,  # noqa: E402
+                     DemRunError, DemUnknownError, DemWarning)
+from .domain import Domain, effects  # noqa: E402
+from .walls import MeshWall, PlaneWall  # noqa: E402
+
+__all__ = ["Domain", "effects", "MeshWall", "PlaneWall", "DemError", "DemFormatError", "DemInvalidArgument",
+           "DemIOError", "DemOverlapError", "DemRunError", "DemUnknownError", "DemWarning", "LIBDEM_VERSION"]

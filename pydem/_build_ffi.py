@@ -1,0 +1,82 @@
+"""Builds pydem._libdem: cffi in out-of-line API mode over the public headers and the static
+libdem (build/libdem.a), so the package carries the engine inside and needs no library path.
+
+The cdef is generated from include/dem/*.h (comments, preprocessor lines, C++ guards and the
+DEM_API export macro removed), so the binding cannot drift from the headers. Run by
+`make pydem` (and so by `make test`):
+
+    .venv/bin/python pydem/_build_ffi.py
+"""
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import cffi
+
+ROOT = Path(__file__).resolve().parent.parent
+INCLUDE = ROOT / "include" / "dem"
+HEADERS = ["base.h", "types.h", "mesh.h", "stress.h", "io.h", "dem.h"]  # dependency order
+KEEP_DEFINES = re.compile(r"#define\s+(DEM_VERSION_(?:MAJOR|MINOR|PATCH))\s+(\d+)\s*$")
+
+
+def header_declarations(text: str) -> str:
+    """The C declarations of one public header, in a form cffi's cdef accepts."""
+    text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+    out, skip_cpp = [], False
+    for line in text.splitlines():
+        s = line.strip()
+        if s.startswith("#"):
+            if s.startswith("#ifdef __cplusplus"):
+                skip_cpp = True
+            elif s.startswith("#endif"):
+                skip_cpp = False
+            m = KEEP_DEFINES.match(s)
+            if m:
+                out.append(f"#define {m.group(1)} {m.group(2)}")
+            continue
+        if skip_cpp:
+            continue
+        out.append(line.replace("DEM_API ", ""))
+    return "\n".join(out)
+
+
+def cdef_source() -> str:
+    return "\n".join(header_declarations((INCLUDE / h).read_text()) for h in HEADERS)
+
+
+def pkg_config(*args: str) -> list[str]:
+    try:
+        return subprocess.run(["pkg-config", *args, "hdf5-serial", "libpng"], check=True, capture_output=True,
+                              text=True).stdout.split()
+    except (OSError, subprocess.CalledProcessError):
+        return ["-lhdf5", "-lpng"] if "--libs" in args else []
+
+
+def build() -> Path:
+    archive = ROOT / "build" / "libdem.a"
+    if not archive.exists():
+        sys.exit(f"pydem: {archive} is missing; run `make lib` first")
+    ffi = cffi.FFI()
+    ffi.cdef(cdef_source())
+    libs = pkg_config("--libs")
+    ffi.set_source(
+        "pydem._libdem",
+        '#include "dem/dem.h"',
+        include_dirs=[str(ROOT / "include")],
+        extra_objects=[str(archive)],
+        library_dirs=[a[2:] for a in libs if a.startswith("-L")],
+        libraries=[a[2:] for a in libs if a.startswith("-l")] + ["m"],
+        extra_compile_args=["-O2"] + pkg_config("--cflags"),
+        extra_link_args=["-fopenmp"],
+    )
+    tmp = ROOT / "build" / "pydem"
+    built = Path(ffi.compile(tmpdir=str(tmp), verbose=False))
+    target = ROOT / "pydem" / built.name
+    shutil.copyfile(built, target)
+    return target
+
+
+if __name__ == "__main__":
+    print(f"pydem: built {build().relative_to(ROOT)}")
