@@ -1,0 +1,133 @@
+"""What every rig does: a domain from the micro parameters, particles poured into a region,
+stepping in chunks with progress and rest detection, frames."""
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..domain import Domain
+from .config import Params
+
+Progress = Callable[[float, float, dict], None]  # (simulated time, planned time, info)
+
+
+def params_from(base: Params, params) -> Params:
+    """base with the fields given in params (a Params, a dict, or None) replaced."""
+    if params is None:
+        return base
+    if isinstance(params, Params):
+        return params
+    p = dataclasses.replace(base, effects={k: dict(v) for k, v in base.effects.items()})
+    for k, v in dict(params).items():
+        if k == "effects":
+            for name, values in v.items():
+                p.effects.setdefault(name, {}).update(values)
+        elif not hasattr(p, k):
+            raise KeyError(f"unknown parameter {k!r}")
+        else:
+            setattr(p, k, v)
+    return p
+
+
+def make_domain(lo, hi, params: Params, num_threads: int = 2, dt: float = 1e-5, skin: float | None = None,
+                diameter: float = 1e-3):
+    """A domain with a particle material and a wall material and their pair constants;
+    the effects act between particles."""
+    d = Domain(lo=lo, hi=hi, dt=dt, num_threads=num_threads, skin=skin if skin is not None else 0.1 * diameter)
+    mp = d.add_material(params.youngs_modulus, params.poisson_ratio, params.density)
+    mw = d.add_material(params.youngs_modulus, params.poisson_ratio, params.density)
+    d.set_pair(mp, mp, params.restitution, params.friction, params.rolling_friction, params.rolling_model)
+    d.set_pair(mp, mw, params.wall_restitution, params.wall_friction, params.wall_rolling_friction, params.rolling_model)
+    for name, values in params.effects.items():
+        d.set_effect(mp, mp, name, **values)
+    return d, mp, mw
+
+
+def stable_dt(d: Domain, impact_speed: float = 0.5, fraction: float = 0.2, steps_per_contact: int = 25) -> float:
+    """min(fraction x Rayleigh time, Hertz contact time at impact_speed / steps_per_contact):
+    20 % of the Rayleigh time is the usual stability bound, 25 steps resolve a collision."""
+    s = d.settings
+    info = d.timestep_info()
+    tc = info["hertz_contact_time"] * (s["reference_velocity"] / impact_speed) ** 0.2  # t_c ~ v^(-1/5)
+    return min(fraction * info["rayleigh_time"], tc / steps_per_contact)
+
+
+def lattice_fill(rng: np.random.Generator, lo, hi, spacing: float, inside: Callable[[np.ndarray], np.ndarray],
+                 count: int | None = None, jitter: float = 0.05) -> np.ndarray:
+    """Jittered cubic lattice points in [lo, hi] kept by `inside`, lowest first; the first
+    `count` of them (all when None)."""
+    axes = [np.arange(lo[a] + 0.5 * spacing, hi[a] - 0.49 * spacing, spacing) for a in range(3)]
+    g = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+    g = g[np.lexsort((g[:, 1], g[:, 0], g[:, 2]))]
+    g = g[inside(g)]
+    g = g + rng.uniform(-jitter, jitter, g.shape) * spacing
+    if count is not None:
+        if len(g) < count:
+            raise ValueError(f"only {len(g)} places for {count} particles: enlarge the fill region")
+        g = g[:count]
+    return g
+
+
+def size_distribution(rng: np.random.Generator, n: int, diameter: float, spread: float) -> np.ndarray:
+    """Radii uniform in diameter (1 +- spread) / 2."""
+    return 0.5 * diameter * (1.0 + spread * rng.uniform(-1.0, 1.0, n))
+
+
+class Stepper:
+    """Steps a domain in chunks, keeping time series, frames and progress reports."""
+
+    def __init__(self, d: Domain, progress: Progress | None = None, planned_time: float = 0.0):
+        self.d, self.progress, self.planned = d, progress, planned_time
+        self.t_wall0 = time.perf_counter()
+        self.steps = 0
+        self.series: dict[str, list] = {}
+
+    def record(self, **values):
+        for k, v in values.items():
+            self.series.setdefault(k, []).append(v)
+
+    def advance(self, seconds: float, chunk: float = 2e-3, each: Callable[[], bool] | None = None) -> bool:
+        """Steps `seconds` of simulated time in chunks; `each` is called after every chunk and
+        may stop early by returning True (returns True then)."""
+        dt = self.d.dt
+        n_chunk = max(1, int(round(chunk / dt)))
+        total = int(round(seconds / dt))
+        done = 0
+        while done < total:
+            k = min(n_chunk, total - done)
+            self.d.step(k)
+            done += k
+            self.steps += k
+            if self.progress is not None:
+                self.progress(self.d.time, self.planned, {"steps": self.steps, "particles": len(self.d),
+                                                          "wall": time.perf_counter() - self.t_wall0})
+            if each is not None and each():
+                return True
+        return False
+
+    def wall_seconds(self) -> float:
+        return time.perf_counter() - self.t_wall0
+
+
+def translational_energy_per_particle(d: Domain, density: float) -> float:
+    """Mean translational kinetic energy (J). Spin is left out on purpose: the contact model
+    has no twisting resistance, so a sphere may keep spinning about its contact normal in a
+    heap that is otherwise at rest."""
+    n = len(d)
+    if not n:
+        return 0.0
+    m = density * 4.0 / 3.0 * np.pi * d.radii ** 3
+    return float(0.5 * np.sum(m * np.sum(d.velocities ** 2, axis=1)) / n)
+
+
+def frame(d: Domain, directory: Path | None, name: str, **render) -> str | None:
+    if directory is None:
+        return None
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / name
+    d.render_png(path, **render)
+    return str(path)

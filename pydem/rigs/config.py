@@ -1,0 +1,160 @@
+"""Rig configurations: dataclasses whose fields carry unit, allowed range and a line of help;
+presets, TOML loading, `key=value` overrides, validation that names the key and the range."""
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A bad configuration: unknown key, wrong type, value out of range."""
+
+
+def knob(default, lo=None, hi=None, unit: str = "", doc: str = "", choices=None):
+    """A config field with its allowed range (inclusive) or choices; a type or a list as the
+    default becomes a factory (fresh per instance)."""
+    meta = {"lo": lo, "hi": hi, "unit": unit, "doc": doc, "choices": choices}
+    if isinstance(default, type):
+        return field(default_factory=default, metadata=meta)
+    if isinstance(default, list):
+        return field(default_factory=lambda: list(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+@dataclass
+class Params:
+    """The DEM micro parameters under calibration (seed 000): particle–particle and
+    particle–wall contact constants, solid properties, and optional effects by name."""
+    friction: float = knob(0.5, 0.0, 2.0, "", "sliding friction mu_s, particle-particle")
+    rolling_friction: float = knob(0.1, 0.0, 1.0, "", "rolling friction mu_r, particle-particle")
+    restitution: float = knob(0.5, 0.05, 1.0, "", "coefficient of restitution e, particle-particle")
+    wall_friction: float = knob(0.5, 0.0, 2.0, "", "sliding friction particle-wall")
+    wall_rolling_friction: float = knob(0.1, 0.0, 1.0, "", "rolling friction particle-wall")
+    wall_restitution: float = knob(0.5, 0.05, 1.0, "", "restitution particle-wall")
+    rolling_model: str = knob("epsd2", doc="rolling resistance model", choices=("cdt", "epsd", "epsd2"))
+    density: float = knob(2500.0, 100.0, 20000.0, "kg/m^3", "solid density")
+    youngs_modulus: float = knob(5e6, 1e5, 1e11, "Pa", "Young's modulus (reduced for speed, as usual in DEM)")
+    poisson_ratio: float = knob(0.25, 0.0, 0.49, "", "Poisson ratio")
+    effects: dict = knob(dict, doc="optional effects: {name: {parameter: value}}, e.g. cohesion_sjkr")
+
+
+def _fields(obj):
+    return {f.name: f for f in dataclasses.fields(obj)}
+
+
+def _coerce(value: Any, default: Any, key: str):
+    if isinstance(default, bool):
+        if isinstance(value, str):
+            if value.lower() in ("1", "true", "yes", "on"):
+                return True
+            if value.lower() in ("0", "false", "no", "off"):
+                return False
+            raise ConfigError(f"{key}: expected true/false, got {value!r}")
+        return bool(value)
+    if isinstance(default, (int, float)) and not isinstance(default, bool):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise ConfigError(f"{key}: expected a number, got {value!r}") from None
+        return int(v) if isinstance(default, int) and float(v).is_integer() else v
+    if isinstance(default, (list, tuple)):
+        if isinstance(value, str):
+            value = [x for x in value.replace("[", "").replace("]", "").split(",") if x.strip()]
+        return type(default)(_coerce(x, default[0] if default else 0.0, key) for x in value)
+    return value if not isinstance(default, str) else str(value)
+
+
+def set_value(cfg, key: str, value: Any):
+    """Sets `key` (a field of the config, `params.<field>`, a Params field name, or
+    `effects.<effect>.<parameter>`) from a string or a value, then checks its range."""
+    parts = key.split(".")
+    if parts[0] == "effects" or (parts[0] == "params" and len(parts) > 1 and parts[1] == "effects"):
+        parts = parts[1:] if parts[0] == "params" else parts
+        if len(parts) != 3:
+            raise ConfigError(f"{key}: effects are set as effects.<effect>.<parameter>=value")
+        from ..domain import effects as registry
+        spec = next((e for e in registry() if e["name"] == parts[1]), None)
+        if spec is None:
+            raise ConfigError(f"{key}: unknown effect {parts[1]!r} (known: {', '.join(e['name'] for e in registry())})")
+        names = [p["name"] for p in spec["params"]]
+        if parts[2] not in names:
+            raise ConfigError(f"{key}: effect {parts[1]!r} has parameters {names}")
+        cfg.params.effects.setdefault(parts[1], {})[parts[2]] = _coerce(value, 0.0, key)
+        return
+    target, name = cfg, parts[-1]
+    if parts[0] == "params" and len(parts) == 2:
+        target = cfg.params
+    elif len(parts) != 1:
+        raise ConfigError(f"unknown key {key!r}")
+    elif name not in _fields(cfg) and name in _fields(cfg.params):
+        target = cfg.params
+    fields = _fields(target)
+    if name not in fields or name == "params":
+        known = sorted(set(_fields(cfg)) - {"params"}) + sorted(_fields(cfg.params))
+        raise ConfigError(f"unknown key {key!r}; known keys: {', '.join(known)}")
+    setattr(target, name, _coerce(value, getattr(target, name), key))
+    check_field(target, fields[name], key)
+
+
+def check_field(obj, f, key: str | None = None):
+    v, m, key = getattr(obj, f.name), f.metadata, key or f.name
+    if m.get("choices") is not None and v not in m["choices"]:
+        raise ConfigError(f"{key} = {v!r} is not allowed; choose one of {', '.join(map(str, m['choices']))}")
+    vals = v if isinstance(v, (list, tuple)) else [v]
+    for x in vals:
+        if not isinstance(x, (int, float)):
+            continue
+        if x != x:
+            raise ConfigError(f"{key} is NaN")
+        if (m.get("lo") is not None and x < m["lo"]) or (m.get("hi") is not None and x > m["hi"]):
+            raise ConfigError(f"{key} = {x:g} is out of range [{m['lo']:g}, {m['hi']:g}] {m.get('unit', '')}".rstrip())
+
+
+def validate(cfg):
+    for obj in (cfg, cfg.params):
+        for f in dataclasses.fields(obj):
+            if f.name != "params":
+                check_field(obj, f)
+
+
+def load(cls, preset: str = "default", path: str | Path | None = None, overrides: list[str] | None = None):
+    """A rig config: the preset, then the TOML file's keys (top level and [params],
+    [effects.<name>] tables), then `key=value` overrides; validated."""
+    cfg = cls.preset(preset)
+    if path is not None:
+        try:
+            data = tomllib.loads(Path(path).read_text())
+        except (OSError, tomllib.TOMLDecodeError) as exc:
+            raise ConfigError(f"cannot read config {path}: {exc}") from None
+        if "preset" in data:
+            cfg = cls.preset(data.pop("preset"))
+        for key, value in data.items():
+            if key in ("params", "effects") and isinstance(value, dict):
+                for k2, v2 in value.items():
+                    if isinstance(v2, dict):
+                        for k3, v3 in v2.items():
+                            set_value(cfg, f"effects.{k2}.{k3}", v3)
+                    else:
+                        set_value(cfg, f"params.{k2}", v2)
+            else:
+                set_value(cfg, key, value)
+    for item in overrides or []:
+        if "=" not in item:
+            raise ConfigError(f"--set expects key=value, got {item!r}")
+        k, v = item.split("=", 1)
+        set_value(cfg, k.strip(), v.strip())
+    validate(cfg)
+    return cfg
+
+
+def describe(cfg) -> list[tuple[str, Any, str, str]]:
+    """(key, value, unit, help) for every knob: for --help texts and reports."""
+    rows = []
+    for obj, prefix in ((cfg, ""), (cfg.params, "params.")):
+        for f in dataclasses.fields(obj):
+            if f.name != "params":
+                rows.append((prefix + f.name, getattr(obj, f.name), f.metadata.get("unit", ""), f.metadata.get("doc", "")))
+    return rows
