@@ -97,6 +97,9 @@ def set_value(cfg, key: str, value: Any):
         raise ConfigError(f"unknown key {key!r}; known keys: {', '.join(known)}")
     setattr(target, name, _coerce(value, getattr(target, name), key))
     check_field(target, fields[name], key)
+    hook = getattr(target, "on_set", None)
+    if hook is not None:
+        hook(name)
 
 
 def check_field(obj, f, key: str | None = None):
