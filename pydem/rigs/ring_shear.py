@@ -1,0 +1,224 @@
+"""Schulze ring shear tester (seed 000): an annular trough with radial bars turns under a lid
+with bars; the lid is held against rotation and servo-loaded to a normal stress; the shear
+stress comes from the lid torque about the axis, tau = T / integral(r dA) = 3 T / (2 pi
+(Ro^3 - Ri^3)), the normal stress from the lid force over its area.
+
+Procedure (DESIGN section 6): pre-shear at sigma_pre to steady flow -> tau_pre; then for each
+shear point (40/60/80 % of sigma_pre): a fresh pre-shear, stop, reduce the load to sigma_sh,
+shear again until failure -> tau_sh (the peak). Outputs mu_ie-ps = tau_pre / sigma_pre,
+mu_ie-s = tau_sh / sigma_sh per point, the yield locus (least-squares line through the shear
+points: slope and intercept), bulk density under the lid, and the inertial number reached,
+I = gamma_dot d / sqrt(sigma_pre / rho_s) with gamma_dot = (omega R_mean) / bed height.
+Steady flow: the mean shear stress of the last two quarters of a pre-shear differ by less
+than `steady_tolerance` (else it continues, up to `max_preshear`)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import geometry
+from .common import Stepper, frame, lattice_fill, make_domain, params_from, size_distribution, stable_dt
+from .config import Params, knob
+from .result import Metric, RigResult, block_average
+
+
+@dataclass
+class RingShearConfig:
+    particles: int = knob(4000, 50, 2_000_000, "", "number of spheres")
+    diameter: float = knob(3e-3, 1e-4, 0.1, "m", "mean sphere diameter")
+    size_spread: float = knob(0.1, 0.0, 0.5, "", "diameters uniform in d (1 +- spread)")
+    inner_radius: float = knob(0.025, 1e-3, 2.0, "m", "trough inner radius Ri")
+    outer_radius: float = knob(0.052, 1e-3, 2.0, "m", "trough outer radius Ro (width >= ~10 d)")
+    bars: int = knob(12, 0, 200, "", "radial bars on the trough floor and under the lid (each)")
+    bar_height: float = knob(2e-3, 0.0, 0.1, "m", "height of the bars (the bed must stay well above 2 bar heights)")
+    preshear_stress: float = knob(2000.0, 10.0, 1e7, "Pa", "pre-shear normal stress sigma_pre")
+    shear_points: list = knob([0.4, 0.6, 0.8], 0.05, 1.0, "", "shear normal stresses as fractions of sigma_pre")
+    shear_speed: float = knob(0.03, 1e-4, 1.0, "m/s", "trough speed at the mean radius")
+    preshear_displacement: float = knob(6e-3, 1e-4, 1.0, "m", "shear displacement of each pre-shear (at R_mean)")
+    first_preshear_displacement: float = knob(1.2e-2, 1e-4, 1.0, "m", "the first pre-shear (from the filled state)")
+    max_preshear: float = knob(3e-2, 1e-4, 1.0, "m", "longest pre-shear when flow is not yet steady")
+    shear_displacement: float = knob(5e-3, 1e-4, 1.0, "m", "longest shear to failure")
+    steady_tolerance: float = knob(0.05, 1e-4, 1.0, "", "steady flow: relative change between the last quarters")
+    servo_speed: float = knob(0.02, 1e-5, 1.0, "m/s", "lid servo speed limit")
+    num_threads: int = knob(2, 1, 256, "", "OpenMP threads")
+    frame_interval: float = knob(0.1, 1e-4, 10.0, "s", "time between frames (with --frames)")
+    params: Params = field(default_factory=Params)
+
+    @classmethod
+    def preset(cls, name: str) -> "RingShearConfig":
+        if name == "tiny":  # tens of seconds: for tests
+            return cls(particles=1200, diameter=3e-3, inner_radius=0.02, outer_radius=0.036, bars=8, bar_height=1.5e-3,
+                       shear_points=[0.5], preshear_displacement=4e-3, first_preshear_displacement=6e-3,
+                       max_preshear=8e-3, shear_displacement=3e-3, shear_speed=0.05)
+        if name == "default":  # <= 3 minutes on 2 cores
+            return cls()
+        if name == "paper":  # a lab Schulze cell of 2 mm spheres (seed 000: silibeads)
+            return cls(particles=60000, diameter=2e-3, inner_radius=0.05, outer_radius=0.1, bars=18,
+                       bar_height=4e-3, shear_speed=0.01)
+        raise ValueError(f"unknown preset {name!r}: tiny, default or paper")
+
+
+class RingShear:
+    name = "ring-shear"
+
+    def __init__(self, config: RingShearConfig | None = None):
+        self.config = config or RingShearConfig.preset("default")
+
+    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None) -> RigResult:
+        c = self.config
+        if not c.outer_radius > c.inner_radius + 4 * c.diameter:
+            raise ValueError("outer_radius must exceed inner_radius by at least 4 diameters")
+        p = params_from(c.params, params)
+        rng = np.random.default_rng(seed)
+        ri, ro, dm = c.inner_radius, c.outer_radius, c.diameter
+        rm = 0.5 * (ri + ro)
+        area = math.pi * (ro ** 2 - ri ** 2)
+        moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
+        radii = size_distribution(rng, c.particles, dm, c.size_spread)
+        spacing = 1.05 * 2 * radii.max()
+        ring = math.pi * ((ro - 0.55 * spacing) ** 2 - (ri + 0.55 * spacing) ** 2) / spacing ** 2
+        fill_top = spacing * (c.particles / max(ring * 0.7, 1.0) + 2) + c.bar_height
+        height = fill_top + 3 * c.bar_height + 4 * dm
+        lo, hi = (-ro - 2 * dm, -ro - 2 * dm, -2 * dm), (ro + 2 * dm, ro + 2 * dm, height)
+        d, mp, mw = make_domain(lo, hi, p, c.num_threads, diameter=dm)
+        d.seed = seed
+        trough = d.add_mesh_wall(geometry.merge(
+            geometry.annulus(ri, ro, 0.0, segments=72, rings=2),
+            geometry.cylinder(ri, 0.0, height, segments=72), geometry.cylinder(ro, 0.0, height, segments=72),
+            geometry.radial_bars(ri, ro, 0.0, c.bar_height, c.bars, 0.1 * dm)), material=mw)
+        pos = lattice_fill(rng, (-ro, -ro, c.bar_height), (ro, ro, fill_top), spacing,
+                           lambda g: (np.hypot(g[:, 0], g[:, 1]) > ri + 0.55 * spacing)
+                           & (np.hypot(g[:, 0], g[:, 1]) < ro - 0.55 * spacing), count=c.particles, jitter=0.02)
+        d.add_particles(pos, radii, mp)
+        d.dt = stable_dt(d, impact_speed=1.0)
+        st = Stepper(d, progress, planned_time=self._planned_time())
+        st.advance(0.25)  # settle
+        top = float((d.positions[:, 2] + d.radii).max())
+        gap = 0.3e-3
+        lid_mesh = geometry.merge(geometry.annulus(ri + gap, ro - gap, 0.0, segments=72, rings=2),
+                                  geometry.radial_bars(ri + gap, ro - gap, -c.bar_height, 0.0, c.bars, 0.1 * dm,
+                                                       phase=math.pi / max(c.bars, 1)))
+        v = lid_mesh[0].copy()
+        v[:, 2] += top + dm
+        lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
+        omega = c.shear_speed / rm
+        frames, fdir, next_frame = [], Path(frames_dir) if frames_dir else None, [0.0]
+        phase_log = []
+
+        def lid_state():
+            f, t = lid.force((0.0, 0.0, 0.0))
+            return f[2] / area, t[2] / moment  # sigma: particles push the lid up; tau: they drag it along +omega
+
+        def sample(tag):
+            def each():
+                s, tau = lid_state()
+                z_lid = lid.pose[0][2] + v[0, 2]
+                st.record(time=d.time, sigma=s, tau=tau, lid_z=z_lid, phase=tag)
+                if fdir is not None and d.time >= next_frame[0]:
+                    frames.append(frame(d, fdir, f"ring_{len(frames):04d}.png", width=420, height=230,
+                                        window=((-ro * 1.05, ro * 1.05), (-0.1 * height, -0.1 * height + 2.1 * ro * 230 / 420))))
+                    next_frame[0] += c.frame_interval
+                return False
+            return each
+
+        def load_to(sigma, max_seconds=0.5):
+            """Servo to sigma and wait until the lid holds it (5 samples within 3 %)."""
+            lid.set_servo(direction=(0, 0, -1), target_stress=sigma, area=area, max_speed=c.servo_speed,
+                          proportional_band=0.3, filter_time=2e-3)
+            record = sample("load")
+
+            def settled():
+                record()
+                last = st.series["sigma"][-5:]
+                return len(last) == 5 and all(abs(x - sigma) < 0.03 * sigma for x in last)
+
+            st.advance(max_seconds, chunk=2e-3, each=settled)
+
+        def preshear(displacement):
+            """Shears at sigma_pre until steady (or max_preshear); returns tau samples of the steady part."""
+            trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
+            start = len(st.series.get("tau", []))
+            chunk = min(0.25 * displacement / c.shear_speed, 0.05)
+            st.advance(displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
+            total = displacement
+            while True:
+                taus = np.array(st.series["tau"][start:])
+                q = len(taus) // 4
+                if q >= 2:
+                    a, b = taus[-2 * q:-q].mean(), taus[-q:].mean()
+                    if abs(b - a) <= c.steady_tolerance * abs(b) or total >= c.max_preshear:
+                        break
+                st.advance(0.25 * displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
+                total += 0.25 * displacement
+            trough.set_motion((0, 0, 0))
+            taus = np.array(st.series["tau"][start:])
+            sig = np.array(st.series["sigma"][start:])
+            half = len(taus) // 2
+            phase_log.append(("preshear", total))
+            return taus[half:], sig[half:]
+
+        def shear_to_failure():
+            trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
+            start = len(st.series["tau"])
+            peak = [-math.inf, 0.0]
+
+            def each():
+                sample("shear")()
+                tau = st.series["tau"][-1]
+                moved = (d.time - t_start) * c.shear_speed
+                if tau > peak[0]:
+                    peak[:] = [tau, st.series["sigma"][-1]]
+                return moved > 0.3 * dm and tau < 0.9 * peak[0]  # past the peak: failed
+
+            t_start = d.time
+            st.advance(c.shear_displacement / c.shear_speed, chunk=0.1 * dm / c.shear_speed, each=each)
+            trough.set_motion((0, 0, 0))
+            taus = np.array(st.series["tau"][start:])
+            phase_log.append(("shear", (d.time - t_start) * c.shear_speed))
+            return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
+
+        load_to(c.preshear_stress, 1.0)
+        steady, sig_steady = preshear(c.first_preshear_displacement)
+        tau_pre, tau_pre_se = block_average(steady, 4)
+        sigma_pre = float(np.mean(sig_steady))
+        z_lid = float(np.mean(st.series["lid_z"][-len(steady):]))
+        mass = float(np.sum(p.density * 4 / 3 * math.pi * d.radii ** 3))
+        res = RigResult("ring-shear")
+        points = []
+        for frac in c.shear_points:
+            s_pre, _ = preshear(c.preshear_displacement)
+            load_to(frac * c.preshear_stress)
+            tau_sh, sigma_sh = shear_to_failure()
+            points.append((frac, sigma_sh, tau_sh, float(np.mean(s_pre))))
+            load_to(c.preshear_stress)
+        res.metrics["tau_preshear"] = Metric(tau_pre, tau_pre_se, "Pa", "steady half of the first pre-shear")
+        res.metrics["sigma_preshear"] = Metric(sigma_pre, float(np.std(sig_steady) / math.sqrt(4)), "Pa", "lid")
+        res.metrics["mu_ie_ps"] = Metric(tau_pre / sigma_pre, tau_pre_se / sigma_pre, "", "tau_pre / sigma_pre")
+        for frac, s, t, _ in points:
+            res.metrics[f"mu_ie_s_{int(round(frac * 100))}"] = Metric(t / s, math.nan, "", f"peak tau / sigma at {frac:.0%}")
+            res.metrics[f"tau_shear_{int(round(frac * 100))}"] = Metric(t, math.nan, "Pa", f"sigma_sh = {s:.0f} Pa")
+        if len(points) >= 2:
+            sig = np.array([q[1] for q in points])
+            tau = np.array([q[2] for q in points])
+            (slope, icpt), cov = np.polyfit(sig, tau, 1, cov=len(points) > 2)
+            err = np.sqrt(np.diag(cov)) if len(points) > 2 else (math.nan, math.nan)
+            res.metrics["yield_locus_slope"] = Metric(float(slope), float(err[0]), "", "least squares through the shear points")
+            res.metrics["yield_locus_intercept"] = Metric(float(icpt), float(err[1]), "Pa", "cohesion estimate")
+        res.metrics["bulk_density"] = Metric(mass / (area * z_lid), math.nan, "kg/m^3", "mass / (lid area x lid height)")
+        gamma_dot = c.shear_speed / z_lid
+        res.metrics["inertial_number"] = Metric(gamma_dot * dm / math.sqrt(sigma_pre / p.density), math.nan, "",
+                                                "shear rate = speed at R_mean / bed height")
+        res.series = {k: np.asarray(v) for k, v in st.series.items()}
+        res.frames = [f for f in frames if f]
+        res.info = {"particles": c.particles, "steps": st.steps, "dt": d.dt, "simulated_time": d.time,
+                    "wall_seconds": st.wall_seconds(), "seed": seed, "phases": phase_log,
+                    "shear_points": [{"fraction": f, "sigma": s, "tau_peak": t} for f, s, t, _ in points]}
+        return res
+
+    def _planned_time(self) -> float:
+        c = self.config
+        shear = (c.first_preshear_displacement + len(c.shear_points) * (c.preshear_displacement + c.shear_displacement))
+        return 0.25 + 0.2 + shear / c.shear_speed + 0.1 * len(c.shear_points)
