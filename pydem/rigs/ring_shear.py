@@ -37,7 +37,7 @@ class RingShearConfig:
     preshear_stress: float = knob(2000.0, 10.0, 1e7, "Pa", "pre-shear normal stress sigma_pre")
     shear_points: list = knob([0.4, 0.6, 0.8], 0.05, 1.0, "", "shear normal stresses as fractions of sigma_pre")
     shear_speed: float = knob(0.03, 1e-4, 1.0, "m/s", "trough speed at the mean radius")
-    preshear_displacement: float = knob(6e-3, 1e-4, 1.0, "m", "shear displacement of each pre-shear (at R_mean)")
+    preshear_displacement: float = knob(5e-3, 1e-4, 1.0, "m", "shear displacement of each pre-shear (at R_mean)")
     first_preshear_displacement: float = knob(1.2e-2, 1e-4, 1.0, "m", "the first pre-shear (from the filled state)")
     max_preshear: float = knob(3e-2, 1e-4, 1.0, "m", "longest pre-shear when flow is not yet steady")
     shear_displacement: float = knob(5e-3, 1e-4, 1.0, "m", "longest shear to failure")
@@ -93,7 +93,7 @@ class RingShear:
                            lambda g: (np.hypot(g[:, 0], g[:, 1]) > ri + 0.55 * spacing)
                            & (np.hypot(g[:, 0], g[:, 1]) < ro - 0.55 * spacing), count=c.particles, jitter=0.02)
         d.add_particles(pos, radii, mp)
-        d.dt = stable_dt(d, impact_speed=1.0)
+        d.dt = stable_dt(d, impact_speed=0.3)  # slow shearing: enduring contacts, gentle impacts
         st = Stepper(d, progress, planned_time=self._planned_time())
         st.advance(0.25)  # settle
         top = float((d.positions[:, 2] + d.radii).max())

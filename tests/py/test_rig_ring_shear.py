@@ -33,7 +33,7 @@ def test_shear_stress_from_torque_closed_form():
     """tau = T / integral(r dA): a uniform tau on the annulus gives back T = tau (2 pi / 3)(Ro^3 - Ri^3)."""
     ri, ro, tau = 0.02, 0.036, 700.0
     r = np.linspace(ri, ro, 200001)
-    torque = np.trapz(tau * r * 2 * math.pi * r, r)
+    torque = np.trapezoid(tau * r * 2 * math.pi * r, r)
     assert torque / (2 * math.pi / 3 * (ro**3 - ri**3)) == pytest.approx(tau, rel=1e-9)
 
 
