@@ -5,12 +5,11 @@
     .venv/bin/python bench/plausibility.py hopper       # Beverloo over slot widths
     .venv/bin/python bench/plausibility.py plot         # redraw the plots from the CSVs
 
-Each finished point is appended to bench/results/plausibility/<sweep>.csv at once, and points
+Each finished point is appended to bench/results/plausibility/<sweep>.jsonl at once, and points
 already there are skipped: a killed sweep resumes where it stopped.
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
 import sys
@@ -25,26 +24,22 @@ from pydem.rigs import (AngleOfRepose, AorConfig, Hopper, HopperConfig, RingShea
                         beverloo_fit, load)
 
 
-def done_keys(path: Path) -> set[str]:
-    if not path.exists():
-        return set()
-    return {row["key"] for row in csv.DictReader(open(path))}
+def rows(name: str) -> list[dict]:
+    """The finished points of a sweep (JSON lines: rigs report different metrics per point)."""
+    p = OUT / f"{name}.jsonl"
+    return [json.loads(line) for line in open(p)] if p.exists() else []
 
 
 def append(path: Path, row: dict):
-    new = not path.exists()
-    with open(path, "a", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(row))
-        if new:
-            w.writeheader()
-        w.writerow(row)
+    with open(path, "a") as f:
+        f.write(json.dumps(row) + "\n")
 
 
 def sweep(name: str, points: list[tuple[str, object, list[str], dict]]):
     """points: (key, rig class, config class, preset, overrides) -> one CSV row of metrics each."""
     OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / f"{name}.csv"
-    have = done_keys(path)
+    path = OUT / f"{name}.jsonl"
+    have = {r["key"] for r in rows(name)}
     for key, rig, cfg_cls, preset, overrides in points:
         if key in have:
             continue
@@ -53,8 +48,8 @@ def sweep(name: str, points: list[tuple[str, object, list[str], dict]]):
         row = {"key": key, "overrides": " ".join(overrides), "wall_s": round(time.perf_counter() - t0, 1)}
         for k, m in res.metrics.items():
             row[k], row[k + "_se"] = m.value, m.uncertainty
-        row["info"] = json.dumps({k: v for k, v in res.info.items() if k in ("particles", "steps", "emptied",
-                                                                           "at_rest", "slot_width")})
+        row["info"] = {k: v for k, v in res.info.items() if k in ("particles", "steps", "emptied", "at_rest",
+                                                                  "slot_width")}
         append(path, row)
         print(f"{name}: {key}: " + ", ".join(f"{k} {m}" for k, m in res.metrics.items()), flush=True)
 
@@ -68,7 +63,7 @@ def aor():
 def ring_shear():
     pts = [(f"mu_s={v}", RingShear, RingShearConfig, "tiny", [f"friction={v}"]) for v in (0.1, 0.3, 0.5, 0.8, 1.2)]
     pts += [(f"coh={c}", RingShear, RingShearConfig, "tiny",
-             ["shear_points=[0.4,0.8]", f"effects.cohesion_sjkr.cohesion_energy_density={c}"]) for c in (0.0, 3e5)]
+             ["shear_points=[0.4,0.8]", f"effects.cohesion_sjkr.cohesion_energy_density={c}"]) for c in (0.0, 5e4)]
     sweep("ring_shear", pts)
 
 
@@ -82,10 +77,6 @@ def plot():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    def rows(name):
-        p = OUT / f"{name}.csv"
-        return list(csv.DictReader(open(p))) if p.exists() else []
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     r = rows("aor")

@@ -250,7 +250,9 @@ class Hopper:
         spacing = 1.05 * dl
         placed = 0
         while placed < len(order):
-            bed = float(d.positions[:, 2].max()) + dl if len(d) else 0.0
+            # lattice centres start 0.55 spacing above the highest sphere top: clear of it
+            # whatever the jitter (0.58 dl >= r_new + 2 % jitter)
+            bed = float((d.positions[:, 2] + d.radii).max()) + 0.55 * spacing if len(d) else 0.0
             g = np.stack(np.meshgrid(np.arange(-0.5 * c.top_width + 0.5 * spacing, 0.5 * c.top_width, spacing),
                                      np.arange(0.5 * spacing, c.thickness - 0.49 * spacing, spacing),
                                      np.arange(max(bed, 0.5 * spacing), z_top - 0.5 * spacing, spacing), indexing="ij"),

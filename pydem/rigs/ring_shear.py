@@ -201,12 +201,9 @@ class RingShear:
             res.metrics[f"mu_ie_s_{int(round(frac * 100))}"] = Metric(t / s, math.nan, "", f"peak tau / sigma at {frac:.0%}")
             res.metrics[f"tau_shear_{int(round(frac * 100))}"] = Metric(t, math.nan, "Pa", f"sigma_sh = {s:.0f} Pa")
         if len(points) >= 2:
-            sig = np.array([q[1] for q in points])
-            tau = np.array([q[2] for q in points])
-            (slope, icpt), cov = np.polyfit(sig, tau, 1, cov=len(points) > 2)
-            err = np.sqrt(np.diag(cov)) if len(points) > 2 else (math.nan, math.nan)
-            res.metrics["yield_locus_slope"] = Metric(float(slope), float(err[0]), "", "least squares through the shear points")
-            res.metrics["yield_locus_intercept"] = Metric(float(icpt), float(err[1]), "Pa", "cohesion estimate")
+            slope, icpt = yield_locus([q[1] for q in points], [q[2] for q in points])
+            res.metrics["yield_locus_slope"] = Metric(*slope, "", "least squares through the shear points")
+            res.metrics["yield_locus_intercept"] = Metric(*icpt, "Pa", "cohesion estimate")
         res.metrics["bulk_density"] = Metric(mass / (area * z_lid), math.nan, "kg/m^3", "mass / (lid area x lid height)")
         gamma_dot = c.shear_speed / z_lid
         res.metrics["inertial_number"] = Metric(gamma_dot * dm / math.sqrt(sigma_pre / p.density), math.nan, "",
@@ -222,3 +219,16 @@ class RingShear:
         c = self.config
         shear = (c.first_preshear_displacement + len(c.shear_points) * (c.preshear_displacement + c.shear_displacement))
         return 0.25 + 0.2 + shear / c.shear_speed + 0.1 * len(c.shear_points)
+
+
+def yield_locus(sigma, tau) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Least-squares line tau = intercept + slope sigma through the shear points:
+    ((slope, its standard error), (intercept, its standard error)); errors need 3+ points."""
+    sigma, tau = np.asarray(sigma, float), np.asarray(tau, float)
+    if len(sigma) > 2:
+        (slope, icpt), cov = np.polyfit(sigma, tau, 1, cov=True)
+        err = np.sqrt(np.diag(cov))
+    else:
+        slope, icpt = np.polyfit(sigma, tau, 1)
+        err = (math.nan, math.nan)
+    return (float(slope), float(err[0])), (float(icpt), float(err[1]))

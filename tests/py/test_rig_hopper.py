@@ -68,3 +68,9 @@ def test_beverloo_fit_recovers_constants():
     assert fit["C"] == pytest.approx(C, rel=1e-9) and fit["k"] == pytest.approx(k, rel=1e-9)
     t = np.linspace(0, 1, 50)
     assert mass_flow_rate(t, 2.0 - 1.5 * t)[0] == pytest.approx(1.5)
+
+
+def test_monodisperse_fill_in_several_batches():
+    """One size only, more spheres than one pouring batch holds: batches must not overlap."""
+    res = Hopper(load(HopperConfig, "tiny", overrides=["fine_fraction=0", "particles=400"])).run(seed=4)
+    assert res.info["particles"] == 400 and res.info["emptied"]

@@ -41,3 +41,11 @@ def test_bad_geometry_is_refused():
     cfg = load(RingShearConfig, "tiny", overrides=["outer_radius=0.025"])
     with pytest.raises(ValueError, match="at least 4 diameters"):
         RingShear(cfg).run()
+
+
+def test_yield_locus_fit():
+    from pydem.rigs.ring_shear import yield_locus
+    (m, m_se), (c, c_se) = yield_locus([800, 1200], [500, 740])
+    assert m == pytest.approx(0.6) and c == pytest.approx(20.0) and math.isnan(m_se)
+    (m, m_se), (c, c_se) = yield_locus([800, 1200, 1600], [500, 740, 980])
+    assert m == pytest.approx(0.6) and c == pytest.approx(20.0) and m_se == pytest.approx(0.0, abs=1e-9)
