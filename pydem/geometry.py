@@ -47,36 +47,34 @@ def rectangle(corner, du, dv, nu: int = 1, nv: int = 1) -> Mesh:
     return _grid(corner, du, dv, nu, nv)
 
 
-def cylinder(radius: float, z0: float, z1: float, centre=(0.0, 0.0), segments: int = 48, rows: int = 1) -> Mesh:
-    """Open cylinder (side wall only) about the vertical axis through centre."""
-    ang = np.linspace(0, 2 * np.pi, segments + 1)[:-1]
-    z = np.linspace(z0, z1, rows + 1)
-    v = np.array([[centre[0] + radius * np.cos(a), centre[1] + radius * np.sin(a), zz] for zz in z for a in ang])
+def _stacked_loops(loops: list[np.ndarray]) -> Mesh:
+    """Triangulates the band between consecutive closed loops of equally many vertices."""
+    segments = len(loops[0])
     tri = []
-    for r in range(rows):
+    for r in range(len(loops) - 1):
         for s in range(segments):
             a, b = r * segments + s, r * segments + (s + 1) % segments
             tri += [[a, b, b + segments], [a, b + segments, a + segments]]
-    return v, np.array(tri)
+    return np.vstack(loops), np.array(tri)
+
+
+def _circle(radius: float, z: float, centre, segments: int) -> np.ndarray:
+    ang = np.linspace(0, 2 * np.pi, segments + 1)[:-1]
+    return np.column_stack([centre[0] + radius * np.cos(ang), centre[1] + radius * np.sin(ang), np.full(segments, z)])
+
+
+def cylinder(radius: float, z0: float, z1: float, centre=(0.0, 0.0), segments: int = 48, rows: int = 1) -> Mesh:
+    """Open cylinder (side wall only) about the vertical axis through centre."""
+    return _stacked_loops([_circle(radius, z, centre, segments) for z in np.linspace(z0, z1, rows + 1)])
 
 
 def annulus(r_inner: float, r_outer: float, z: float, centre=(0.0, 0.0), segments: int = 48, rings: int = 1) -> Mesh:
     """Flat ring at height z."""
-    ang = np.linspace(0, 2 * np.pi, segments + 1)[:-1]
-    rad = np.linspace(r_inner, r_outer, rings + 1)
-    v = np.array([[centre[0] + r * np.cos(a), centre[1] + r * np.sin(a), z] for r in rad for a in ang])
-    tri = []
-    for k in range(rings):
-        for s in range(segments):
-            a, b = k * segments + s, k * segments + (s + 1) % segments
-            tri += [[a, b, b + segments], [a, b + segments, a + segments]]
-    return v, np.array(tri)
+    return _stacked_loops([_circle(r, z, centre, segments) for r in np.linspace(r_inner, r_outer, rings + 1)])
 
 
 def disk(radius: float, z: float, centre=(0.0, 0.0), segments: int = 48) -> Mesh:
-    ang = np.linspace(0, 2 * np.pi, segments + 1)[:-1]
-    v = np.vstack([[centre[0], centre[1], z], np.column_stack([centre[0] + radius * np.cos(ang),
-                                                              centre[1] + radius * np.sin(ang), np.full(segments, z)])])
+    v = np.vstack([[centre[0], centre[1], z], _circle(radius, z, centre, segments)])
     tri = np.array([[0, 1 + s, 1 + (s + 1) % segments] for s in range(segments)])
     return v, tri
 
