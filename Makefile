@@ -96,8 +96,11 @@ $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 bench: setup lib $(BENCH_BIN)
 	@sh bench/run_bench.sh
 
-demo: setup lib $(BUILD)/bench/packed_bed
-	$(BUILD)/bench/packed_bed --demo
+# the main job (until the calibration loop lands): the angle-of-repose rig at its default
+# preset, with progress, a summary, a result file and frames
+demo: setup lib
+	@$(MAKE) --no-print-directory pydem
+	.venv/bin/pydem rig aor --out $(BUILD)/demo_aor.h5 --frames $(BUILD)/demo_frames
 
 install: lib pydem
 	install -d $(DESTDIR)$(PREFIX)/include/dem $(DESTDIR)$(PREFIX)/lib/pkgconfig
