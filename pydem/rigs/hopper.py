@@ -9,8 +9,8 @@ Assumptions where seed 001 gives no numbers (its Fig. 1 is not in the text): the
 (top width 200 mm, walls 30 degrees from vertical, slot 54 mm = 6 large diameters, slab 40 mm
 thick, a 150 mm vertical section above the wedge); the layer orders B1: fine below coarse, B2:
 coarse below fine, B3: fine-coarse-fine, B4: coarse-fine-coarse (bottom to top), layer
-thicknesses by the fine volume fraction; frames are 230 wide x 420 high (the seed's
-(420, 230, 3) images read as height x width, a hopper standing upright)."""
+thicknesses by the fine volume fraction; frames are 420 wide x 230 high with the whole hopper
+in the middle, so the seed's centre crop to 224 x 224 keeps the hopper and its outlet."""
 from __future__ import annotations
 
 import csv
@@ -73,8 +73,8 @@ class HopperConfig:
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")
     num_threads: int = knob(2, 1, 256, "", "OpenMP threads")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between frames (with --frames)")
-    frame_width: int = knob(230, 16, 8192, "px", "frame width")
-    frame_height: int = knob(420, 16, 8192, "px", "frame height")
+    frame_width: int = knob(420, 16, 8192, "px", "frame width")
+    frame_height: int = knob(230, 16, 8192, "px", "frame height")
     case: str = knob("", doc="a seed-001 Table 1 case (A-1 ... B4-5): sets N, sizes, packing, parameters",
                      choices=("",) + tuple(TABLE1))
     params: Params = field(default_factory=Params)
