@@ -194,6 +194,8 @@ dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i);
 
 /* mesh_bins.c: candidate triangles of every particle (called by the neighbour build) */
 dem_status dem_mesh_candidates(dem_domain *d);
+/* forget an entry's contact: inactive, no history, no force, point or normal */
+void dem_tri_entry_clear(tri_list *tl, int64_t k);
 void dem_mesh_free_all(dem_domain *d);
 
 /* mesh.c: finishing a mesh from x_ref/tri (edges, world, normals; 0: out of memory), adding

@@ -107,7 +107,7 @@ static void carry_entry(const tri_list *old, int64_t q, tri_list *tl, int64_t k)
     memcpy(tl->normal + 3 * k, old->normal + 3 * q, 3 * sizeof(double));
 }
 
-static void clear_entry(tri_list *tl, int64_t k)
+void dem_tri_entry_clear(tri_list *tl, int64_t k)
 {
     tl->active[k] = 0;
     memset(tl->hist + 6 * k, 0, 6 * sizeof(double));
@@ -161,7 +161,7 @@ dem_status dem_mesh_candidates(dem_domain *d)
             if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
             tl->mesh[count] = d->tri_cell_mesh[s];
             tl->tri[count] = t;
-            clear_entry(tl, count);
+            dem_tri_entry_clear(tl, count);
             int32_t oi = d->perm[i];
             if (oi < old_rows)
                 for (int64_t k = old->start[oi]; k < old->start[oi + 1]; k++)

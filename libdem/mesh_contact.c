@@ -97,11 +97,12 @@ static void select_contacts(const dem_domain *d, double r, touch *tc, int nt)
     }
 }
 
-static void clear_entry(tri_list *tl, int64_t k)
+/* Does entry k carry one of the accepted contacts? (nt is small: a handful at most) */
+static int is_accepted(const touch *tc, int nt, int64_t k)
 {
-    tl->active[k] = 0;
-    memset(tl->hist + 6 * k, 0, 6 * sizeof(double));
-    memset(tl->force + 3 * k, 0, 3 * sizeof(double));
+    for (int a = 0; a < nt; a++)
+        if (tc[a].accepted && tc[a].k == k) return 1;
+    return 0;
 }
 
 void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad)
@@ -116,13 +117,6 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         return;
     }
     select_contacts(d, r, tc, nt);
-    uint8_t keep[MAX_TOUCHING * 4];
-    const int64_t span = k1 - k0;
-    /* entries that keep a contact (for the spans we handle on the stack; longer lists are rare
-     * and simply skip the inheritance search bookkeeping below) */
-    for (int64_t k = 0; k < span && k < (int64_t)sizeof keep; k++) keep[k] = 0;
-    for (int a = 0; a < nt; a++)
-        if (tc[a].accepted && tc[a].k - k0 < (int64_t)sizeof keep) keep[tc[a].k - k0] = 1;
 
     const pair_props *row_pairs = d->pairs + (size_t)d->mat[i] * d->n_materials;
     for (int a = 0; a < nt; a++) {
@@ -133,11 +127,11 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         const double inv = tc[a].dist > 1e-12 * r ? 1.0 / tc[a].dist : 0.0;
         for (int b = 0; b < 3; b++) n[b] = (p[b] - tc[a].q[b]) * inv;
         if (inv == 0.0) memcpy(n, m->normal + 3 * tl->tri[k], sizeof n); /* centre on the surface */
-        if (!tl->active[k] && span <= (int64_t)sizeof keep) { /* new here: take over a contact that just left */
+        if (!tl->active[k]) { /* new here: take over a contact that just left */
             int64_t best = -1;
             double best_dot = 0.5;
             for (int64_t o = k0; o < k1; o++) {
-                if (!tl->active[o] || keep[o - k0] || tl->mesh[o] != tl->mesh[k]) continue;
+                if (!tl->active[o] || tl->mesh[o] != tl->mesh[k] || is_accepted(tc, nt, o)) continue;
                 const double *no = tl->normal + 3 * o;
                 double dot = no[0] * n[0] + no[1] * n[1] + no[2] * n[2];
                 if (dot > best_dot) {
@@ -147,7 +141,7 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
             }
             if (best >= 0) {
                 memcpy(tl->hist + 6 * k, tl->hist + 6 * best, 6 * sizeof(double));
-                clear_entry(tl, best);
+                dem_tri_entry_clear(tl, best);
             }
         }
         const double *q = tc[a].q, *om = m->omega; /* surface velocity v + w x (q - c) */
@@ -169,12 +163,8 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         tl->active[k] = 1;
     }
     /* entries without a contact now forget theirs */
-    for (int64_t k = k0; k < k1; k++) {
-        if (!tl->active[k]) continue;
-        int kept = 0;
-        for (int a = 0; a < nt && !kept; a++) kept = tc[a].accepted && tc[a].k == k;
-        if (!kept) clear_entry(tl, k);
-    }
+    for (int64_t k = k0; k < k1; k++)
+        if (tl->active[k] && !is_accepted(tc, nt, k)) dem_tri_entry_clear(tl, k);
 }
 
 /* Cold path: why particle i was flagged by dem_mesh_contacts. */
