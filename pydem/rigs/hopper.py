@@ -172,8 +172,7 @@ class Hopper:
         n_fine, n_coarse = species_counts(c.particles, c.d_small, c.d_large, c.fine_fraction)
         order = self._filling_order(rng, n_fine, n_coarse)  # True = fine, bottom first
         st = Stepper(d, progress, planned_time=c.max_time)
-        self._fill(d, rng, order, mf, mp, h_wedge, z_top, st)
-        d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
+        self._fill(d, rng, order, mf, mp, h_wedge, z_top, st)  # sets the time step as it pours
         st.advance(c.settle_time)
         density = self._bulk_density(d, p, h_wedge)
         n_initial = len(d)
@@ -270,8 +269,8 @@ class Hopper:
             radii = np.where(fine, 0.5 * c.d_small, 0.5 * c.d_large)
             d.add_particles(g, radii, np.where(fine, mf, mp))
             placed += len(g)
-            if placed == len(g):
-                d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
+            # each batch may bring the smaller species first (B2, B4): the step follows
+            d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
             st.advance(0.15 if placed < len(order) else 0.0)
 
     def _bulk_density(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
