@@ -11,7 +11,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from ._libdem import ffi, lib
-from .errors import DemInvalidArgument, check
+from .errors import DemInvalidArgument, DemUnknownError, check
 
 ROLLING_MODELS = {"cdt": lib.DEM_ROLLING_CDT, "epsd": lib.DEM_ROLLING_EPSD, "epsd2": lib.DEM_ROLLING_EPSD2}
 REGIONS = {"box": lib.DEM_REGION_BOX, "cylinder": lib.DEM_REGION_CYLINDER, "annular_sector": lib.DEM_REGION_ANNULAR_SECTOR}
@@ -149,7 +149,6 @@ class Domain:
         spec = next((e for e in effects() if e["name"] == name), None)
         if spec is None:
             names = ", ".join(e["name"] for e in effects())
-            from .errors import DemUnknownError
             raise DemUnknownError(f"no effect named {name!r} (known: {names})", "DEM_ERR_UNKNOWN_EFFECT")
         params = list(values)
         for p in spec["params"][len(params):]:
