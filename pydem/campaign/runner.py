@@ -1,0 +1,212 @@
+"""Running a campaign: every sample goes through the pure function `simulate`, locally in a
+process pool (default) or on a Dask cluster; each finished run is saved to the store at once."""
+from __future__ import annotations
+
+import math
+import os
+import platform
+import subprocess
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+from .design import design_points
+from .spec import CampaignSpec
+from .store import DONE, FAILED, CampaignStore, StoreError
+
+
+def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
+    """One rig run: parameters in, metrics out ({name: (value, uncertainty, unit)}), or the
+    error message. Pure (depends on its arguments only); runs in a worker process."""
+    t0 = time.perf_counter()
+    try:
+        from ..rigs import RIGS
+        spec = CampaignSpec.from_json(spec_json)
+        cfg = spec.config(values)
+        if "num_threads" not in spec.fixed:
+            cfg.num_threads = 1  # parallelism comes from running samples side by side
+        result = RIGS[spec.rig][0](cfg).run(seed=seed)
+        metrics = {k: (float(m.value), float(m.uncertainty), m.unit) for k, m in result.metrics.items()
+                   if isinstance(m.value, (int, float))}
+        return {"metrics": metrics, "wall": time.perf_counter() - t0}
+    except Exception as exc:  # recorded in the store; the campaign goes on
+        last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+        where = f" (at {Path(last.filename).name}:{last.lineno})" if last else ""
+        return {"error": f"{type(exc).__name__}: {exc}{where}", "wall": time.perf_counter() - t0}
+
+
+def sample_seed(campaign_seed: int, index: int) -> int:
+    return int(np.random.SeedSequence([campaign_seed, index]).generate_state(1)[0])
+
+
+def provenance() -> dict:
+    from .. import LIBDEM_VERSION, __version__
+    root = Path(__file__).resolve().parents[2]
+    commit = "unknown"
+    try:
+        commit = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
+                                timeout=10).stdout.strip() or "unknown"
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10).stdout.strip()
+        commit += "+changes" if dirty else ""
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return {"pydem": __version__, "libdem": LIBDEM_VERSION, "git_commit": commit, "host": platform.node(),
+            "machine": f"{platform.machine()}, {os.cpu_count()} cores", "python": platform.python_version(),
+            "command": " ".join(sys.argv), "created": time.strftime("%Y-%m-%d %H:%M:%S %z")}
+
+
+class Progress:
+    """done/total, rate, ETA and failures on one refreshed stderr line."""
+
+    def __init__(self, total: int, already: int, stream=sys.stderr, quiet: bool = False):
+        self.total, self.already, self.stream, self.quiet = total, already, stream, quiet
+        self.t0, self.done, self.failed = time.perf_counter(), 0, 0
+
+    def update(self, ok: bool):
+        self.done += 1
+        self.failed += 0 if ok else 1
+        if self.quiet:
+            return
+        el = time.perf_counter() - self.t0
+        rate = self.done / el if el > 0 else 0.0
+        left = self.total - self.already - self.done
+        eta = left / rate if rate > 0 else math.inf
+        self.stream.write(f"\r  {self.already + self.done}/{self.total} runs   {rate * 60:6.2f} runs/min   "
+                          f"ETA {eta / 60:6.1f} min   failures {self.failed} ")
+        self.stream.flush()
+
+    def close(self):
+        if not self.quiet and self.done:
+            self.stream.write("\n")
+
+
+class Campaign:
+    def __init__(self, store: CampaignStore):
+        self.store = store
+
+    @classmethod
+    def create(cls, path: str | Path, spec: CampaignSpec) -> "Campaign":
+        path = Path(path)
+        if path.exists():
+            raise StoreError(f"{path} exists already: run it again to continue, or choose another name")
+        store = CampaignStore(path, spec, provenance())
+        c = cls(store)
+        c.grow(spec.samples)
+        store.save()
+        return c
+
+    @classmethod
+    def open(cls, path: str | Path) -> "Campaign":
+        return cls(CampaignStore.open(path))
+
+    def grow(self, total: int):
+        """Extends the design to `total` samples (existing samples and results unchanged)."""
+        s, spec = self.store, self.store.spec
+        n0 = len(s)
+        if total <= n0:
+            return
+        batches = s.batches + [total - n0]
+        pts = design_points(spec.design, spec.ranges, n0, total, spec.seed, batches, spec.log_scale)
+        s.append(pts, np.array([sample_seed(spec.seed, i) for i in range(n0, total)]))
+        spec.samples = total
+
+    def run(self, workers: int | None = None, dask: str | None = None, retry_failed: bool = False,
+            max_runs: int | None = None, quiet: bool = False) -> dict[str, int]:
+        """Runs the pending samples (and failed ones with retry_failed); saves after each."""
+        s = self.store
+        s.lock()
+        try:
+            todo = s.pending(retry_failed)[:max_runs]
+            if not todo:
+                return s.counts()
+            s.save()  # a grown design is on disk before any run starts
+            spec_json = s.spec.to_json()
+            progress = Progress(len(s), len(s) - len(s.pending(retry_failed)), quiet=quiet)
+            args = {i: (spec_json, dict(zip(s.spec.names, map(float, s.params[i]))), int(s.seeds[i])) for i in todo}
+            try:
+                if dask:
+                    self._run_dask(dask, args, progress)
+                else:
+                    self._run_local(workers, args, progress)
+            finally:
+                progress.close()
+            return s.counts()
+        finally:
+            s.unlock()
+
+    def _finish(self, i: int, out: dict, progress: Progress):
+        if "error" in out:
+            self.store.record_failure(i, out["error"], out["wall"])
+        else:
+            self.store.record_done(i, out["metrics"], out["wall"])
+        self.store.save()
+        progress.update("error" not in out)
+
+    def _run_local(self, workers, args, progress):
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures.process import BrokenProcessPool
+        threads = int(self.store.spec.fixed.get("num_threads", 1))
+        workers = workers or max(1, (os.cpu_count() or 1) // threads)
+        # spawn: a fresh interpreter per worker (forking a process that holds OpenMP threads is unsafe)
+        with ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=mp.get_context("spawn")) as pool:
+            futures = {pool.submit(simulate, *a): i for i, a in args.items()}
+            try:
+                for fut in as_completed(futures):
+                    self._finish(futures[fut], fut.result(), progress)
+            except BrokenProcessPool:
+                raise StoreError("a worker process died (killed or out of memory); finished runs are saved, the others "
+                                 "stay pending: run the campaign again to continue") from None
+            except BaseException:
+                for f in futures:
+                    f.cancel()
+                raise
+
+    def _run_dask(self, address, args, progress):
+        try:
+            from distributed import Client, as_completed
+        except ImportError:
+            raise StoreError("--dask needs the 'distributed' package (pip install distributed)") from None
+        with Client(address, timeout="30s") as client:
+            futures = {client.submit(simulate, *a, pure=False, key=f"pydem-sample-{i}-{a[2]}"): i for i, a in args.items()}
+            index = {f.key: i for f, i in futures.items()}
+            for fut in as_completed(list(futures)):
+                self._finish(index[fut.key], fut.result(), progress)
+
+    def status_text(self) -> str:
+        s = self.store
+        c = s.counts()
+        spec = s.spec
+        lines = [f"campaign {s.path}: rig {spec.rig} (preset {spec.preset}), design {spec.design} seed {spec.seed}",
+                 f"  samples {len(s)}: done {c['done']}, failed {c['failed']}, pending {c['pending']}"]
+        done = s.status == DONE
+        if done.any():
+            w = s.wall[done]
+            lines.append(f"  wall time per run: median {np.median(w):.1f} s, total {w.sum() / 3600:.2f} h of worker time")
+        lines.append("  ranges: " + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in spec.ranges.items()))
+        if spec.fixed:
+            lines.append("  fixed: " + ", ".join(f"{k}={v}" for k, v in spec.fixed.items()))
+        lines.append("  metrics: " + (", ".join(s.metric_names) or "none yet"))
+        for i in np.flatnonzero(s.status == FAILED)[:10]:
+            lines.append(f"  failed #{i}: {s.errors[i]}")
+        p = s.provenance
+        lines.append(f"  provenance: pydem {p.get('pydem')} libdem {p.get('libdem')} commit {p.get('git_commit')} "
+                     f"on {p.get('host')} ({p.get('machine')}), {p.get('created')}")
+        lines.append(f"  command: {p.get('command')}")
+        return "\n".join(lines)
+
+    def export_csv(self, path: str | Path):
+        s = self.store
+        import csv
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["index", "seed", "status"] + s.spec.names + s.metric_names
+                       + [m + "_uncertainty" for m in s.metric_names] + ["wall_seconds", "error"])
+            for i in range(len(s)):
+                w.writerow([i, int(s.seeds[i]), ("pending", "done", "failed")[s.status[i]]]
+                           + [repr(float(x)) for x in s.params[i]] + [repr(float(x)) for x in s.values[i]]
+                           + [repr(float(x)) for x in s.uncertainty[i]] + [repr(float(s.wall[i])), s.errors[i]])

@@ -1,0 +1,174 @@
+"""The campaign store: one HDF5 file with the specification, the provenance, every sample's
+parameters, seed, status, metrics (value and uncertainty), wall time and failure message.
+
+Crash safety: the store is small (kilobytes per hundred runs), so every update writes a complete
+new file next to it, flushes it to disk and atomically renames it over the old one. A kill at any
+moment leaves either the previous or the new store, never a torn one, and no finished run is
+lost once `save` has returned. One writer at a time (a lock file next to the store)."""
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .spec import CampaignSpec
+
+FORMAT = "pydem-campaign"
+FORMAT_VERSION = 1
+PENDING, DONE, FAILED = 0, 1, 2
+STATUS_NAMES = {PENDING: "pending", DONE: "done", FAILED: "failed"}
+
+
+class StoreError(RuntimeError):
+    """A campaign store that cannot be read, written or locked."""
+
+
+class CampaignStore:
+    def __init__(self, path: str | Path, spec: CampaignSpec, provenance: dict):
+        self.path = Path(path)
+        self.spec, self.provenance = spec, provenance
+        self.batches: list[int] = []
+        self.params = np.zeros((0, len(spec.names)))
+        self.seeds = np.zeros(0, dtype=np.int64)
+        self.status = np.zeros(0, dtype=np.int8)
+        self.wall = np.zeros(0)
+        self.finished_at = np.zeros(0)
+        self.errors: list[str] = []
+        self.metric_names: list[str] = []
+        self.metric_units: list[str] = []
+        self.values = np.zeros((0, 0))
+        self.uncertainty = np.zeros((0, 0))
+        self._lock = None
+
+    # ---- size and content ------------------------------------------------------------
+    def __len__(self):
+        return len(self.seeds)
+
+    def append(self, params: np.ndarray, seeds: np.ndarray):
+        n = len(seeds)
+        self.batches.append(n)
+        self.params = np.vstack([self.params, params])
+        self.seeds = np.concatenate([self.seeds, np.asarray(seeds, dtype=np.int64)])
+        self.status = np.concatenate([self.status, np.zeros(n, dtype=np.int8)])
+        self.wall = np.concatenate([self.wall, np.full(n, np.nan)])
+        self.finished_at = np.concatenate([self.finished_at, np.full(n, np.nan)])
+        self.errors += [""] * n
+        self.values = np.vstack([self.values, np.full((n, self.values.shape[1]), np.nan)])
+        self.uncertainty = np.vstack([self.uncertainty, np.full((n, self.uncertainty.shape[1]), np.nan)])
+
+    def _column(self, name: str, unit: str) -> int:
+        if name not in self.metric_names:
+            self.metric_names.append(name)
+            self.metric_units.append(unit)
+            pad = np.full((len(self), 1), np.nan)
+            self.values = np.hstack([self.values, pad])
+            self.uncertainty = np.hstack([self.uncertainty, pad.copy()])
+        return self.metric_names.index(name)
+
+    def record_done(self, i: int, metrics: dict, wall: float):
+        """metrics: {name: (value, uncertainty, unit)}."""
+        for name, (v, u, unit) in metrics.items():
+            j = self._column(name, unit)
+            self.values[i, j], self.uncertainty[i, j] = v, u
+        self.status[i], self.wall[i], self.finished_at[i], self.errors[i] = DONE, wall, time.time(), ""
+
+    def record_failure(self, i: int, message: str, wall: float):
+        self.status[i], self.wall[i], self.finished_at[i], self.errors[i] = FAILED, wall, time.time(), message
+
+    def pending(self, retry_failed: bool = False) -> list[int]:
+        todo = (self.status == PENDING) | ((self.status == FAILED) if retry_failed else False)
+        return [int(i) for i in np.flatnonzero(todo)]
+
+    def counts(self) -> dict[str, int]:
+        return {name: int((self.status == s).sum()) for s, name in STATUS_NAMES.items()}
+
+    def table(self, metric: str, only_done: bool = True):
+        """(inputs, values, uncertainties) of one metric over the finished runs with a finite value."""
+        if metric not in self.metric_names:
+            raise StoreError(f"{self.path}: no metric {metric!r} (has: {', '.join(self.metric_names) or 'none yet'})")
+        j = self.metric_names.index(metric)
+        ok = np.isfinite(self.values[:, j]) & ((self.status == DONE) if only_done else True)
+        return self.params[ok], self.values[ok, j], self.uncertainty[ok, j]
+
+    # ---- file ------------------------------------------------------------------------
+    def lock(self):
+        """Exclusive writer lock; a second `campaign run` on the same store stops with an error."""
+        self._lock = open(str(self.path) + ".lock", "a+")
+        try:
+            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self._lock.close()
+            self._lock = None
+            raise StoreError(f"{self.path} is being written by another campaign process (lock {self.path}.lock)") from None
+
+    def unlock(self):
+        if self._lock is not None:
+            fcntl.flock(self._lock, fcntl.LOCK_UN)
+            self._lock.close()
+            self._lock = None
+
+    def save(self):
+        import h5py
+        tmp = self.path.with_name(f".{self.path.name}.tmp-{os.getpid()}")
+        with h5py.File(tmp, "w") as f:
+            f.attrs["format"], f.attrs["format_version"] = FORMAT, FORMAT_VERSION
+            f.attrs["spec"] = self.spec.to_json()
+            f.attrs["provenance"] = json.dumps(self.provenance, sort_keys=True, default=str)
+            f.attrs["batches"] = json.dumps(self.batches)
+            f.attrs["saved_at"] = time.time()
+            f.create_dataset("parameter_names", data=np.array(self.spec.names, dtype=object), dtype=h5py.string_dtype())
+            f.create_dataset("parameters", data=self.params)
+            f.create_dataset("seed", data=self.seeds)
+            f.create_dataset("status", data=self.status)
+            f.create_dataset("wall_seconds", data=self.wall)
+            f.create_dataset("finished_at", data=self.finished_at)
+            f.create_dataset("error", data=np.array(self.errors, dtype=object), dtype=h5py.string_dtype())
+            f.create_dataset("metric_names", data=np.array(self.metric_names, dtype=object), dtype=h5py.string_dtype())
+            f.create_dataset("metric_units", data=np.array(self.metric_units, dtype=object), dtype=h5py.string_dtype())
+            f.create_dataset("metrics", data=self.values)
+            f.create_dataset("metric_uncertainty", data=self.uncertainty)
+            f.flush()
+            os.fsync(f.id.get_vfd_handle())
+        os.replace(tmp, self.path)
+        dirfd = os.open(self.path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dirfd)
+        finally:
+            os.close(dirfd)
+
+    @classmethod
+    def open(cls, path: str | Path) -> "CampaignStore":
+        import h5py
+        path = Path(path)
+        if not path.exists():
+            raise StoreError(f"{path}: no such campaign store")
+        for stale in path.parent.glob(f".{path.name}.tmp-*"):  # a write interrupted by a kill
+            stale.unlink(missing_ok=True)
+        try:
+            with h5py.File(path, "r") as f:
+                if f.attrs.get("format") != FORMAT:
+                    raise StoreError(f"{path}: not a pydem campaign store (format attribute {f.attrs.get('format')!r})")
+                if int(f.attrs["format_version"]) > FORMAT_VERSION:
+                    raise StoreError(f"{path}: store format {f.attrs['format_version']} is newer than this pydem reads")
+                s = cls(path, CampaignSpec.from_json(f.attrs["spec"]), json.loads(f.attrs["provenance"]))
+                s.batches = json.loads(f.attrs["batches"])
+                s.params = f["parameters"][()]
+                s.seeds, s.status = f["seed"][()], f["status"][()]
+                s.wall, s.finished_at = f["wall_seconds"][()], f["finished_at"][()]
+                s.errors = [x.decode() if isinstance(x, bytes) else str(x) for x in f["error"][()]]
+                s.metric_names = [x.decode() if isinstance(x, bytes) else str(x) for x in f["metric_names"][()]]
+                s.metric_units = [x.decode() if isinstance(x, bytes) else str(x) for x in f["metric_units"][()]]
+                s.values, s.uncertainty = f["metrics"][()], f["metric_uncertainty"][()]
+        except StoreError:
+            raise
+        except (OSError, KeyError, ValueError, json.JSONDecodeError) as exc:
+            raise StoreError(f"{path}: unreadable campaign store ({type(exc).__name__}: {exc})") from None
+        n = len(s.seeds)
+        if not (s.params.shape == (n, len(s.spec.names)) and len(s.status) == n and s.values.shape[0] == n
+                and sum(s.batches) == n and len(s.errors) == n):
+            raise StoreError(f"{path}: inconsistent campaign store (array lengths disagree)")
+        return s
