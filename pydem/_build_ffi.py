@@ -8,6 +8,7 @@ DEM_API export macro removed), so the binding cannot drift from the headers. Run
     .venv/bin/python pydem/_build_ffi.py
 """
 import re
+import os
 import shutil
 import subprocess
 import sys
@@ -17,7 +18,7 @@ import cffi
 
 ROOT = Path(__file__).resolve().parent.parent
 INCLUDE = ROOT / "include" / "dem"
-HEADERS = ["base.h", "types.h", "mesh.h", "stress.h", "io.h", "dem.h"]  # dependency order
+HEADERS = ["base.h", "types.h", "mesh.h", "stress.h", "io.h", "mlp.h", "dem.h"]  # dependency order
 KEEP_DEFINES = re.compile(r"#define\s+(DEM_VERSION_(?:MAJOR|MINOR|PATCH))\s+(\d+)\s*$")
 
 
@@ -74,7 +75,11 @@ def build() -> Path:
     tmp = ROOT / "build" / "pydem"
     built = Path(ffi.compile(tmpdir=str(tmp), verbose=False))
     target = ROOT / "pydem" / built.name
-    shutil.copyfile(built, target)
+    # copy, then rename over the old module: processes that have it loaded (a running campaign)
+    # keep their mapping; writing into the loaded file in place would crash them
+    staging = target.with_name(f".{target.name}.new")
+    shutil.copyfile(built, staging)
+    os.replace(staging, target)
     return target
 
 

@@ -13,6 +13,7 @@
 #include "mesh.h"
 #include "stress.h"
 #include "io.h"
+#include "mlp.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,0 +1,1 @@
+"""nn: surrogate networks (MLP per bulk property with SCG, export to C)."""

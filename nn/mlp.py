@@ -1,0 +1,157 @@
+"""One MLP per bulk property (seed 000): inputs and target scaled to [-1, 1] (min–max), one tanh
+hidden layer, linear output; trained full-batch with SCG in float64, early stopping on a
+validation split (6 consecutive failures, as MATLAB trainscg)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+
+from .scg import SCG
+
+
+@dataclass
+class Scaler:
+    """Maps [lo, hi] to [-1, 1] per column (MATLAB mapminmax)."""
+    lo: np.ndarray
+    hi: np.ndarray
+
+    @classmethod
+    def fit(cls, a: np.ndarray) -> "Scaler":
+        a = np.atleast_2d(np.asarray(a, dtype=float).T).T
+        lo, hi = a.min(axis=0), a.max(axis=0)
+        if np.any(hi <= lo):
+            raise ValueError("a column is constant: it cannot be scaled to [-1, 1] (drop it or widen its range)")
+        return cls(lo, hi)
+
+    def forward(self, a):
+        return (np.asarray(a, dtype=float) - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
+
+    def inverse(self, s):
+        return (np.asarray(s, dtype=float) + 1.0) * ((self.hi - self.lo) / 2.0) + self.lo
+
+
+class MLP(torch.nn.Module):
+    def __init__(self, inputs: int, hidden: int):
+        super().__init__()
+        self.hidden = torch.nn.Linear(inputs, hidden, dtype=torch.float64)
+        self.out = torch.nn.Linear(hidden, 1, dtype=torch.float64)
+
+    def forward(self, x):
+        return self.out(torch.tanh(self.hidden(x))).squeeze(-1)
+
+
+@dataclass
+class PropertyNet:
+    """A trained net with its scalers, in physical units at both ends."""
+    name: str
+    input_names: list[str]
+    x_scaler: Scaler
+    y_scaler: Scaler
+    model: MLP
+    unit: str = ""
+    info: dict = field(default_factory=dict)
+
+    @property
+    def hidden(self) -> int:
+        return self.model.hidden.out_features
+
+    def predict(self, x: np.ndarray) -> np.ndarray:
+        xs = torch.from_numpy(self.x_scaler.forward(np.atleast_2d(x)))
+        with torch.no_grad():
+            ys = self.model(xs).numpy()
+        return self.y_scaler.inverse(ys[:, None])[:, 0]
+
+
+def r2_score(y: np.ndarray, pred: np.ndarray) -> float:
+    ss_res = float(np.sum((y - pred) ** 2))
+    ss_tot = float(np.sum((y - np.mean(y)) ** 2))
+    return 1.0 - ss_res / ss_tot if ss_tot > 0 else math.nan
+
+
+def train_net(xs: np.ndarray, ys: np.ndarray, hidden: int, seed: int, val_fraction: float = 0.15,
+              max_epochs: int = 1000, max_fail: int = 6, min_grad: float = 1e-6) -> tuple[MLP, dict]:
+    """Trains on scaled data (xs in [-1,1]^d, ys in [-1,1]); returns the model at its best
+    validation loss and a record of the training."""
+    g = torch.Generator().manual_seed(seed)
+    n = len(ys)
+    order = torch.randperm(n, generator=g).numpy()
+    n_val = max(1, int(round(val_fraction * n))) if n >= 8 else 0
+    val, tr = order[:n_val], order[n_val:]
+    x_t, y_t = torch.from_numpy(xs[tr]), torch.from_numpy(ys[tr])
+    x_v, y_v = torch.from_numpy(xs[val]), torch.from_numpy(ys[val])
+    torch.manual_seed(seed)
+    model = MLP(xs.shape[1], hidden)
+    opt = SCG(model.parameters())
+
+    def closure():
+        opt.zero_grad()
+        loss = torch.mean((model(x_t) - y_t) ** 2)
+        loss.backward()
+        return loss
+
+    best, best_state, fails, epoch, stop = math.inf, None, 0, 0, "max_epochs"
+    for epoch in range(1, max_epochs + 1):
+        opt.step(closure)
+        if n_val:
+            with torch.no_grad():
+                v = float(torch.mean((model(x_v) - y_v) ** 2))
+            if v < best:
+                best, fails = v, 0
+                best_state = {k: t.clone() for k, t in model.state_dict().items()}
+            else:
+                fails += 1
+                if fails >= max_fail:
+                    stop = "validation"
+                    break
+        if opt.gradient_norm < min_grad:
+            stop = "min_grad"
+            break
+    if best_state is not None:
+        model.load_state_dict(best_state)
+    return model, {"epochs": epoch, "stop": stop, "val_mse": best, "scg_successes": opt.successes}
+
+
+def holdout_split(n: int, fraction: float = 0.15, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """A fixed, seeded hold-out: (train+validation indices, hold-out indices)."""
+    order = np.random.default_rng(seed).permutation(n)
+    k = max(1, int(round(fraction * n)))
+    return np.sort(order[k:]), np.sort(order[:k])
+
+
+def select_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, sizes=range(2, 41, 2),
+               restarts: int = 3, holdout: float = 0.15, seed: int = 0, unit: str = "",
+               progress=None) -> tuple[PropertyNet, list[dict]]:
+    """Hidden-size selection (seed 000): every size trained `restarts` times on the same data;
+    the net with the best hold-out R^2 is kept. Returns it and the R^2-vs-size table."""
+    torch.set_num_threads(1)  # tiny nets: threads cost more than they give
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.all(np.isfinite(x), axis=1) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if len(y) < 10:
+        raise ValueError(f"{name}: {len(y)} finished samples are too few to train and hold out 15 %")
+    fit_idx, hold_idx = holdout_split(len(y), holdout, seed)
+    xsc, ysc = Scaler.fit(x[fit_idx]), Scaler.fit(y[fit_idx, None])
+    xs, ys = xsc.forward(x), ysc.forward(y[:, None])[:, 0]
+    table, best = [], None
+    for h in sizes:
+        row = {"hidden": int(h), "holdout_r2": [], "train_r2": []}
+        for k in range(restarts):
+            model, rec = train_net(xs[fit_idx], ys[fit_idx], int(h), seed=seed * 7919 + 131 * int(h) + k)
+            net = PropertyNet(name, list(input_names), xsc, ysc, model, unit)
+            r2_hold = r2_score(y[hold_idx], net.predict(x[hold_idx]))
+            r2_fit = r2_score(y[fit_idx], net.predict(x[fit_idx]))
+            row["holdout_r2"].append(r2_hold)
+            row["train_r2"].append(r2_fit)
+            if best is None or r2_hold > best[0]:
+                best = (r2_hold, net, rec, r2_fit, k)
+        row["best_holdout_r2"] = max(row["holdout_r2"])
+        table.append(row)
+        if progress:
+            progress(name, int(h), row["best_holdout_r2"])
+    r2_hold, net, rec, r2_fit, k = best
+    net.info = {"holdout_r2": r2_hold, "train_r2": r2_fit, "samples": int(len(y)), "holdout_samples": int(len(hold_idx)),
+                "restart": k, **rec}
+    return net, table

@@ -1,0 +1,188 @@
+/* MLP inference and screening (include/dem/mlp.h) against a golden vector: a net exported by
+ * scripts/make_mlp_fixture.py and its torch float64 outputs on 64 inputs (hex floats, exact).
+ * Tolerance 1e-12 relative (DESIGN section 7): the sums run in another order than torch's
+ * matmul and tanh differs by an ulp or two, so agreement is ~1e-15, far inside 1e-12. */
+#include "test_util.h"
+
+#include <dem/mlp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GOLDEN "tests/data/mlp/golden.mlp"
+#define GOLDEN_IO "tests/data/mlp/golden_io.txt"
+#define NROWS 64
+
+static int read_golden(double x[NROWS][3], double y[NROWS])
+{
+    FILE *fp = fopen(GOLDEN_IO, "r");
+    char line[512];
+    int n = 0;
+    if (!fp)
+        return 0;
+    while (fgets(line, sizeof line, fp) && n < NROWS) {
+        if (line[0] == '#')
+            continue;
+        if (sscanf(line, "%la %la %la %la", &x[n][0], &x[n][1], &x[n][2], &y[n]) == 4)
+            ++n;
+    }
+    fclose(fp);
+    return n;
+}
+
+static void test_golden_outputs(void **state)
+{
+    double x[NROWS][3], y[NROWS], many[NROWS];
+    dem_mlp *net = NULL;
+    char err[256] = "";
+    int i;
+    (void)state;
+    assert_int_equal(read_golden(x, y), NROWS);
+    assert_int_equal(dem_mlp_load(GOLDEN, &net, err, sizeof err), DEM_OK);
+    assert_string_equal(dem_mlp_name(net), "golden");
+    assert_string_equal(dem_mlp_unit(net), "");
+    assert_int_equal(dem_mlp_num_inputs(net), 3);
+    assert_int_equal(dem_mlp_num_hidden(net), 9);
+    assert_string_equal(dem_mlp_input_name(net, 1), "rolling_friction");
+    assert_null(dem_mlp_input_name(net, 3));
+    assert_int_equal(dem_mlp_eval_many(net, &x[0][0], NROWS, many, 2), DEM_OK);
+    for (i = 0; i < NROWS; ++i) {
+        assert_close(dem_mlp_eval(net, x[i]), y[i], 1e-12, 0.0);
+        assert_close(many[i], y[i], 1e-12, 0.0);
+    }
+    dem_mlp_free(net);
+}
+
+static void test_save_round_trip_is_exact(void **state)
+{
+    dem_mlp *a = NULL, *b = NULL;
+    double x[NROWS][3], y[NROWS];
+    char err[256];
+    int i;
+    (void)state;
+    read_golden(x, y);
+    assert_int_equal(dem_mlp_load(GOLDEN, &a, err, sizeof err), DEM_OK);
+    assert_int_equal(dem_mlp_save(a, "build/test_mlp_roundtrip.mlp", err, sizeof err), DEM_OK);
+    assert_int_equal(dem_mlp_load("build/test_mlp_roundtrip.mlp", &b, err, sizeof err), DEM_OK);
+    for (i = 0; i < NROWS; ++i) /* same weights bit for bit -> same outputs bit for bit */
+        assert_true(dem_mlp_eval(a, x[i]) == dem_mlp_eval(b, x[i]));
+    dem_mlp_free(a);
+    dem_mlp_free(b);
+}
+
+static char *golden_text(void)
+{
+    FILE *fp = fopen(GOLDEN, "rb");
+    char *text = calloc(1, 1 << 16);
+    size_t n = fread(text, 1, (1 << 16) - 1, fp);
+    fclose(fp);
+    text[n] = '\0';
+    return text;
+}
+
+/* Replaces the first line starting with `key` by `line` (NULL: drops it). */
+static char *edit(const char *text, const char *key, const char *line)
+{
+    char *out = calloc(1, strlen(text) + 512);
+    const char *p = text;
+    while (*p) {
+        size_t len = strcspn(p, "\n");
+        if (strncmp(p, key, strlen(key)) == 0 && p[strlen(key)] == ' ') {
+            if (line) {
+                strcat(out, line);
+                strcat(out, "\n");
+            }
+        } else {
+            strncat(out, p, len + 1);
+        }
+        p += len + (p[len] == '\n');
+    }
+    return out;
+}
+
+static void expect_format_error(const char *text, const char *needle)
+{
+    dem_mlp *net = (dem_mlp *)1;
+    char err[256] = "";
+    assert_int_equal(dem_mlp_parse(text, &net, err, sizeof err), DEM_ERR_FORMAT);
+    assert_null(net);
+    if (!strstr(err, needle))
+        fail_msg("error '%s' does not mention '%s'", err, needle);
+}
+
+static void test_malformed_files_are_named(void **state)
+{
+    char *g = golden_text(), *t;
+    dem_mlp *net = NULL;
+    char err[256] = "";
+    (void)state;
+    t = edit(g, "b2", NULL);
+    expect_format_error(t, "'b2' is missing");
+    free(t);
+    t = edit(g, "b1", "b1 1 2 3");
+    expect_format_error(t, "(b1): expected 9 numbers, found 3");
+    free(t);
+    t = edit(g, "w2", "w2 1 2 3 4 5 6 7 8 nan");
+    expect_format_error(t, "(w2): value 9 is not finite");
+    free(t);
+    t = edit(g, "hidden", "hidden 0");
+    expect_format_error(t, "(hidden)");
+    free(t);
+    t = edit(g, "dem-mlp", "dem-mlp 2");
+    expect_format_error(t, "version 2");
+    free(t);
+    t = edit(g, "input_hi", "input_hi 1 0.6 0.2");
+    expect_format_error(t, "restitution");
+    free(t);
+    t = edit(g, "b2", "b2 1 2");
+    expect_format_error(t, "more than");
+    free(t);
+    t = edit(g, "unit", "colour blue");
+    expect_format_error(t, "line 3: unknown keyword 'colour'");
+    free(t);
+    assert_int_equal(dem_mlp_load("tests/data/mlp/no_such_file.mlp", &net, err, sizeof err), DEM_ERR_IO);
+    assert_non_null(strstr(err, "no_such_file.mlp"));
+    assert_int_equal(dem_mlp_parse(NULL, &net, err, sizeof err), DEM_ERR_NULL);
+    free(g);
+}
+
+static void test_screen_keeps_rows_within_the_window(void **state)
+{
+    double x[NROWS][3], y[NROWS], pred[NROWS * 2], target[2], window[2] = {0.05, 1.0};
+    unsigned char keep[NROWS];
+    const dem_mlp *nets[2];
+    dem_mlp *a = NULL;
+    size_t kept = 0, expect = 0;
+    char err[256];
+    int i;
+    (void)state;
+    read_golden(x, y);
+    assert_int_equal(dem_mlp_load(GOLDEN, &a, err, sizeof err), DEM_OK);
+    nets[0] = nets[1] = a;
+    target[0] = target[1] = y[7]; /* a window around one golden output */
+    assert_int_equal(dem_mlp_screen(nets, 2, target, window, &x[0][0], NROWS, 2, keep, pred, &kept, err, sizeof err),
+                     DEM_OK);
+    for (i = 0; i < NROWS; ++i) {
+        int inside = fabs(y[i] - target[0]) <= 0.05 * fabs(target[0]);
+        assert_int_equal(keep[i], inside);
+        assert_close(pred[2 * i], y[i], 1e-12, 0.0);
+        expect += (size_t)inside;
+    }
+    assert_true(kept == expect && kept >= 1);
+    window[1] = -1.0;
+    assert_int_equal(dem_mlp_screen(nets, 2, target, window, &x[0][0], NROWS, 1, keep, NULL, &kept, err, sizeof err),
+                     DEM_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "window"));
+    dem_mlp_free(a);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_golden_outputs),
+        cmocka_unit_test(test_save_round_trip_is_exact),
+        cmocka_unit_test(test_malformed_files_are_named),
+        cmocka_unit_test(test_screen_keeps_rows_within_the_window),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
