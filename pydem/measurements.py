@@ -1,0 +1,122 @@
+"""Measurement files (docs/measurements.md): CSV, one row a measured value, `#` comment lines.
+
+    material,test,quantity,value,uncertainty,unit,conditions,use,source
+    glass_microbeads,ring_shear,mu_ie_s,0.45995,0.00867,,shear_fraction=0.5,calibrate,VSB ...
+
+test: ring_shear | aor | hopper | poured (bulk density of a poured fill: the AoR rig's filled
+cylinder); anything else is kept but matched to no rig;
+conditions: `key=value` pairs separated by `;` (pre-shear stress, shear fraction, size cut ...);
+uncertainty: one standard uncertainty, empty when not published; use: `calibrate` (screened
+against) or `compare` (shown in comparisons only). Errors name the file, line and column."""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+COLUMNS = ["material", "test", "quantity", "value", "uncertainty", "unit", "conditions", "use", "source"]
+USES = ("calibrate", "compare")
+RIG_OF_TEST = {"ring_shear": "ring-shear", "aor": "aor", "hopper": "hopper", "poured": "aor"}  # poured: the AoR fill
+
+
+class MeasurementError(ValueError):
+    """A malformed measurement file (the message names the line and the column)."""
+
+
+@dataclass
+class Measurement:
+    material: str
+    test: str
+    quantity: str
+    value: float
+    uncertainty: float  # NaN when not published
+    unit: str = ""
+    conditions: dict[str, str] = field(default_factory=dict)
+    use: str = "calibrate"
+    source: str = ""
+    line: int = 0
+
+    @property
+    def rig(self) -> str | None:
+        return RIG_OF_TEST.get(self.test)
+
+    @property
+    def metric(self) -> str:
+        """The rig metric this value is compared with (mu_ie_s at a shear fraction f -> mu_ie_s_<100 f>)."""
+        if self.test == "ring_shear" and self.quantity in ("mu_ie_s", "tau_shear") and "shear_fraction" in self.conditions:
+            return f"{self.quantity}_{round(100 * float(self.conditions['shear_fraction']))}"
+        return self.quantity
+
+    @property
+    def label(self) -> str:
+        cond = ", ".join(f"{k}={v}" for k, v in self.conditions.items())
+        return f"{self.test}:{self.quantity}" + (f" ({cond})" if cond else "")
+
+
+def _number(text: str, where: str, allow_empty: bool) -> float:
+    text = text.strip()
+    if text == "" and allow_empty:
+        return math.nan
+    try:
+        v = float(text)
+    except ValueError:
+        raise MeasurementError(f"{where}: expected a number, got {text!r}") from None
+    if not math.isfinite(v):
+        raise MeasurementError(f"{where}: {text!r} is not a finite number")
+    return v
+
+
+def load(path: str | Path, material: str | None = None) -> list[Measurement]:
+    """All rows (or those of one material); raises MeasurementError naming line and column."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeasurementError(f"{path}: cannot read ({exc})") from None
+    numbered = [(i + 1, ln) for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not numbered:
+        raise MeasurementError(f"{path}: no header and no rows")
+    rows = list(csv.reader([ln for _, ln in numbered]))
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in COLUMNS[:5] if c not in header]
+    if missing:
+        raise MeasurementError(f"{path}:{numbered[0][0]}: header lacks column(s) {', '.join(missing)} "
+                               f"(expected {','.join(COLUMNS)})")
+    unknown = [c for c in header if c not in COLUMNS]
+    if unknown:
+        raise MeasurementError(f"{path}:{numbered[0][0]}: unknown column(s) {', '.join(unknown)}")
+    out = []
+    for (lineno, _), row in zip(numbered[1:], rows[1:]):
+        if len(row) != len(header):
+            raise MeasurementError(f"{path}:{lineno}: {len(row)} fields, the header has {len(header)}")
+        rec = dict(zip(header, (x.strip() for x in row)))
+        where = lambda col: f"{path}:{lineno}, column '{col}'"  # noqa: E731
+        for col in ("material", "test", "quantity"):
+            if not rec[col]:
+                raise MeasurementError(f"{where(col)}: empty")
+        value = _number(rec["value"], where("value"), False)
+        unc = _number(rec["uncertainty"], where("uncertainty"), True)
+        if unc == unc and unc <= 0:
+            raise MeasurementError(f"{where('uncertainty')}: must be positive (or empty when unknown), got {unc:g}")
+        conditions = {}
+        for item in filter(None, (s.strip() for s in rec.get("conditions", "").split(";"))):
+            if "=" not in item:
+                raise MeasurementError(f"{where('conditions')}: expected key=value, got {item!r}")
+            k, v = item.split("=", 1)
+            conditions[k.strip()] = v.strip()
+        if "shear_fraction" in conditions:
+            f = _number(conditions["shear_fraction"], where("conditions") + " shear_fraction", False)
+            if not 0 < f <= 1:
+                raise MeasurementError(f"{where('conditions')}: shear_fraction {f:g} must lie in (0, 1]")
+        use = rec.get("use", "") or "calibrate"
+        if use not in USES:
+            raise MeasurementError(f"{where('use')}: {use!r} is not one of {', '.join(USES)}")
+        m = Measurement(rec["material"], rec["test"], rec["quantity"], value, unc, rec.get("unit", ""), conditions, use,
+                        rec.get("source", ""), lineno)
+        if material is None or m.material == material:
+            out.append(m)
+    if material is not None and not out:
+        known = sorted({r[header.index("material")] for r in rows[1:] if len(r) == len(header)})
+        raise MeasurementError(f"{path}: no rows for material {material!r} (materials: {', '.join(known)})")
+    return out
