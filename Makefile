@@ -3,7 +3,7 @@
 #   make test       set-up (idempotent), build, every C test (plain, then under ASan/UBSan),
 #                   then the Python tests
 #   make bench      benchmarks (results in bench/results/)
-#   make demo       the main job
+#   make demo       the main job (calibration of glass microbeads, report in build/calibration)
 #   make install PREFIX=/usr/local
 CC      ?= gcc
 PREFIX  ?= /usr/local
@@ -28,7 +28,7 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib pydem setup test test-c test-sanitize test-py bench demo install clean FORCE
+.PHONY: all lib pydem setup test test-c test-sanitize test-py bench bench-screening demo install clean FORCE
 
 all: lib pydem
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
@@ -96,11 +96,20 @@ $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 bench: setup lib $(BENCH_BIN)
 	@sh bench/run_bench.sh
 
-# the main job (until the calibration loop lands): the angle-of-repose rig at its default
-# preset, with progress, a summary, a result file and frames
+# the main job: calibrate glass microbeads from the shipped campaigns and measurements
+# (train + select the MLPs, export, screen 2^20 combinations natively, narrow, confirm by DEM,
+# report in build/calibration/report.md)
+DEMO_CAMPAIGNS := data/campaigns/ring_shear_tiny.h5 data/campaigns/aor_tiny.h5
 demo: setup lib
 	@$(MAKE) --no-print-directory pydem
-	.venv/bin/pydem rig aor --out $(BUILD)/demo_aor.h5 --frames $(BUILD)/demo_frames
+	.venv/bin/pydem calibrate --measurements data/measurements/glass_microbeads.csv --material glass_microbeads \
+	  $(addprefix --campaign ,$(DEMO_CAMPAIGNS)) --out $(BUILD)/calibration
+
+# screening throughput: libdem vs torch on the nets `make demo` trained
+bench-screening: setup lib
+	@$(MAKE) --no-print-directory pydem
+	@[ -d $(BUILD)/calibration/nets ] || $(MAKE) --no-print-directory demo
+	$(PYTHON) bench/screening.py
 
 install: lib pydem
 	install -d $(DESTDIR)$(PREFIX)/include/dem $(DESTDIR)$(PREFIX)/lib/pkgconfig

@@ -65,8 +65,9 @@ def table_markdown(res: list[Residual]) -> str:
         lines.append(f"| {r.m.label} | {r.m.value:.4g}{u}{unit} | {model} | {r.residual:+.3g} | {z} | {rel} | {r.m.use} |")
     o = overall(res)
     lines.append("")
+    chi2 = f"{o['chi2_per_value']:.2f}" if o["chi2_values"] else "n/a"
     lines.append(f"Overall: RMSE of relative residuals {100 * o['rmse_relative']:.2f} % over {o['modelled']} modelled values; "
-                 f"chi^2 per value {o['chi2_per_value']:.2f} over the {o['chi2_values']} values with uncertainties "
+                 f"chi^2 per value {chi2} over the {o['chi2_values']} values with uncertainties "
                  "(no degrees of freedom subtracted: the parameters are an admissible set, not a least-squares fit).")
     return "\n".join(lines)
 

@@ -138,7 +138,7 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
     for n, r in summary["ranges"].items():
         L.append(f"| {n} | {_fmt_range(r)} | " + " | ".join(_fmt_range(st["ranges"][n]) for st in summary["stages"]) + " |")
     first, last = summary["stages"][0]["admissible"], summary["stages"][-1]["admissible"]
-    if len(summary["stages"]) > 1:
+    if len(summary["stages"]) > 1 and summary["stages"][0]["measured"]:
         if summary["stages"][-1]["measured"]:
             L += ["", f"The angle-of-repose nets narrowed the admissible set from {first:,} to {last:,} combinations "
                   f"({100 * (1 - last / first) if first else 0:.1f} % removed)."]
@@ -151,13 +151,24 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
             y = NativeMLP(out / "nets" / f"{k}.mlp")(sc.points[sc.admissible[-1]])
             L.append(f"- {k}: predicted {np.percentile(y, 5):.4g} – {np.percentile(y, 95):.4g} (5–95 %) over the "
                      f"admissible set")
+    reach = []
+    for net, m in zip(cnets, calib):
+        y = net(sc.points[np.random.default_rng(2).choice(len(sc.points), min(len(sc.points), 100000), replace=False)])
+        reach.append(f"- {m.label}: measured {m.value:.4g}; the surrogate reaches {y.min():.4g} – {y.max():.4g} over the box")
+    if reach:
+        L += ["", "Reachable by the model (surrogate over the screening box):", ""] + reach
     if summary["skipped_measurements"]:
         L += ["", "Measured values without a net (not screened): " + ", ".join(summary["skipped_measurements"])]
     L += ["", "![admissible region](admissible.png)", ""]
     if has_pvm:
         L += ["![predicted vs measured](predicted_vs_measured.png)", ""]
-    L += ["## Best estimate", "", "The admissible combination with the least misfit (sum of squared residuals over the "
-          "measured uncertainties):", ""]
+    if len(sc.admissible[-1]):
+        L += ["## Best estimate", "", "The admissible combination with the least misfit (sum of squared residuals over "
+              "the measured uncertainties):", ""]
+    else:
+        L += ["## Best estimate", "", "**No combination is admissible.** Shown instead: the combination of least misfit "
+              "over the whole box — the model cannot reproduce the measurements within the window there (see the "
+              "reachable ranges below): a sign of a missing physical effect or too narrow a box.", ""]
     L += [f"- **{k}** = {v:.4g}" for k, v in summary["best"].items()]
     L += ["", "## Model vs measurements", "", "### Surrogate at the best estimate", "", cmp.table_markdown(res_sur), ""]
     if res_dem:

@@ -123,7 +123,10 @@ class Campaign:
             todo = s.pending(retry_failed)[:max_runs]
             if not todo:
                 return s.counts()
-            s.save()  # a grown design is on disk before any run starts
+            now = provenance()  # every session that adds runs is recorded (code version, machine)
+            s.provenance.setdefault("sessions", []).append(
+                {k: now[k] for k in ("git_commit", "host", "machine", "created", "command")} | {"pending": len(todo)})
+            s.save()  # a grown design and this session are on disk before any run starts
             spec_json = s.spec.to_json()
             progress = Progress(len(s), len(s) - len(s.pending(retry_failed)), quiet=quiet)
             args = {i: (spec_json, dict(zip(s.spec.names, map(float, s.params[i]))), int(s.seeds[i])) for i in todo}
