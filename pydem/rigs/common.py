@@ -34,10 +34,11 @@ def params_from(base: Params, params) -> Params:
 
 
 def make_domain(lo, hi, params: Params, num_threads: int = 2, dt: float = 1e-5, skin: float | None = None,
-                diameter: float = 1e-3):
+                diameter: float = 1e-3, max_overlap_ratio: float = 0.3):
     """A domain with a particle material and a wall material and their pair constants;
     the effects act between particles."""
-    d = Domain(lo=lo, hi=hi, dt=dt, num_threads=num_threads, skin=skin if skin is not None else 0.1 * diameter)
+    d = Domain(lo=lo, hi=hi, dt=dt, num_threads=num_threads, skin=skin if skin is not None else 0.1 * diameter,
+               max_overlap_ratio=max_overlap_ratio)
     mp = d.add_material(params.youngs_modulus, params.poisson_ratio, params.density)
     mw = d.add_material(params.youngs_modulus, params.poisson_ratio, params.density)
     d.set_pair(mp, mp, params.restitution, params.friction, params.rolling_friction, params.rolling_model)
