@@ -128,7 +128,8 @@ class Campaign:
                 {k: now[k] for k in ("git_commit", "host", "machine", "created", "command")} | {"pending": len(todo)})
             s.save()  # a grown design and this session are on disk before any run starts
             spec_json = s.spec.to_json()
-            progress = Progress(len(s), len(s) - len(s.pending(retry_failed)), quiet=quiet)
+            already = int((s.status == DONE).sum() + ((s.status == FAILED).sum() if not retry_failed else 0))
+            progress = Progress(already + len(todo), already, quiet=quiet)  # ETA of this invocation
             args = {i: (spec_json, dict(zip(s.spec.names, map(float, s.params[i]))), int(s.seeds[i])) for i in todo}
             try:
                 if dask:
