@@ -152,6 +152,8 @@ def select_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
         if progress:
             progress(name, int(h), row["best_holdout_r2"])
     r2_hold, net, rec, r2_fit, k = best
+    pred_hold = net.predict(x[hold_idx])
     net.info = {"holdout_r2": r2_hold, "train_r2": r2_fit, "samples": int(len(y)), "holdout_samples": int(len(hold_idx)),
-                "restart": k, **rec}
+                "holdout_rmse": float(np.sqrt(np.mean((pred_hold - y[hold_idx]) ** 2))), "restart": k,
+                "holdout_simulated": y[hold_idx].tolist(), "holdout_predicted": pred_hold.tolist(), **rec}
     return net, table

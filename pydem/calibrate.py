@@ -48,16 +48,11 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
             write_weights(net, nets_dir / f"{key}.mlp")
             net.name = key
             write_c(net, nets_dir / "c")
-            # hold-out RMSE, for the surrogate's uncertainty in comparisons
-            from nn.mlp import holdout_split
-            ok = np.all(np.isfinite(x), axis=1) & np.isfinite(y)
-            _, hold = holdout_split(int(ok.sum()), 0.15, seed)
-            resid = net.predict(x[ok][hold]) - y[ok][hold]
-            meta[key] = {"rig": rig, "metric": metric, "hidden": net.hidden, "holdout_r2": net.info["holdout_r2"],
-                         "train_r2": net.info["train_r2"], "samples": net.info["samples"],
-                         "holdout_samples": net.info["holdout_samples"], "holdout_rmse": float(np.sqrt(np.mean(resid ** 2))),
-                         "unit": net.unit, "seconds": time.perf_counter() - t0,
-                         "parity": {"simulated": y[ok][hold].tolist(), "predicted": (resid + y[ok][hold]).tolist()}}
+            i = net.info
+            meta[key] = {"rig": rig, "metric": metric, "hidden": net.hidden, "unit": net.unit,
+                         "seconds": time.perf_counter() - t0,
+                         **{k: i[k] for k in ("holdout_r2", "train_r2", "samples", "holdout_samples", "holdout_rmse")},
+                         "parity": {"simulated": i["holdout_simulated"], "predicted": i["holdout_predicted"]}}
             tables[key] = table
             _say(f"  {key:32s} hidden {net.hidden:3d}   hold-out R^2 {net.info['holdout_r2']:.4f}   "
                  f"({net.info['samples']} runs, {time.perf_counter() - t0:.1f} s)")
