@@ -31,23 +31,22 @@ static inline double fast_tanh(double x)
 {
     const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
     const double log2e = 1.44269504088896338700e+00, shifter = 6755399441055744.0; /* 1.5 x 2^52 */
-    double a = fabs(x), y, kd, r, q, scale, t, em1;
+    double a = fabs(x), y, kd, r, r2, r4, r8, b0, b1, b2, q, scale, t, em1;
     uint64_t bits;
     a = a < 20.0 ? a : 20.0;
     y = -2.0 * a;
-    kd = (y * log2e + shifter) - shifter; /* round to nearest integer */
+    kd = MADD(y, log2e, shifter) - shifter; /* round to nearest integer */
     r = (y - kd * ln2_hi) - kd * ln2_lo;
-    q = MADD(1.0 / 479001600.0, r, 1.0 / 39916800.0);
-    q = MADD(q, r, 1.0 / 3628800.0);
-    q = MADD(q, r, 1.0 / 362880.0);
-    q = MADD(q, r, 1.0 / 40320.0);
-    q = MADD(q, r, 1.0 / 5040.0);
-    q = MADD(q, r, 1.0 / 720.0);
-    q = MADD(q, r, 1.0 / 120.0);
-    q = MADD(q, r, 1.0 / 24.0);
-    q = MADD(q, r, 1.0 / 6.0);
-    q = MADD(q, r, 0.5);
-    q = MADD(q * r, r, r);
+    /* q = r + r^2 (1/2! + r/3! + ... + r^10/12!) by Estrin's scheme: a dependency chain of ~6
+     * operations instead of Horner's 11, so the vector units stay busy */
+    r2 = r * r;
+    r4 = r2 * r2;
+    r8 = r4 * r4;
+    b0 = MADD(MADD(1.0 / 120.0, r, 1.0 / 24.0), r2, MADD(1.0 / 6.0, r, 0.5));
+    b1 = MADD(MADD(1.0 / 362880.0, r, 1.0 / 40320.0), r2, MADD(1.0 / 5040.0, r, 1.0 / 720.0));
+    b2 = MADD(1.0 / 479001600.0, r2, MADD(1.0 / 39916800.0, r, 1.0 / 3628800.0));
+    q = MADD(b2, r8, MADD(b1, r4, b0));
+    q = MADD(q, r2, r);
     t = kd + shifter;
     memcpy(&bits, &t, sizeof bits);
     bits = (bits + 1023u) << 52;

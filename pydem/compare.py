@@ -117,6 +117,7 @@ def surrogate_model(nets_dir: str | Path, params: dict[str, float]) -> dict[str,
         if missing:
             raise ValueError(f"{f.name} needs parameter(s) {', '.join(missing)}")
         rig, metric = f.stem.split("__", 1)
+        rig = meta.get(f.stem, {}).get("rig", rig.replace("_", "-"))  # file names use ring_shear for ring-shear
         x = np.array([[params[n] for n in net.input_names]])
         out[f"{rig}:{metric}"] = (float(net(x)[0]), float(meta.get(f.stem, {}).get("holdout_rmse", math.nan)))
     return out

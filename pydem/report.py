@@ -138,7 +138,7 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
     for n, r in summary["ranges"].items():
         L.append(f"| {n} | {_fmt_range(r)} | " + " | ".join(_fmt_range(st["ranges"][n]) for st in summary["stages"]) + " |")
     first, last = summary["stages"][0]["admissible"], summary["stages"][-1]["admissible"]
-    if len(summary["stages"]) > 1 and summary["stages"][0]["measured"]:
+    if len(summary["stages"]) > 1 and summary["stages"][0]["measured"] and first:
         if summary["stages"][-1]["measured"]:
             L += ["", f"The angle-of-repose nets narrowed the admissible set from {first:,} to {last:,} combinations "
                   f"({100 * (1 - last / first) if first else 0:.1f} % removed)."]

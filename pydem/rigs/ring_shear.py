@@ -107,7 +107,7 @@ class RingShear:
                                   geometry.radial_bars(ri + gap, ro - gap, -c.bar_height, 0.0, c.bars, 0.1 * dm,
                                                        phase=math.pi / max(c.bars, 1)))
         v = lid_mesh[0].copy()
-        v[:, 2] += top + dm
+        v[:, 2] += top + dm + max(0.0, c.bar_height - 0.8 * dm)  # bar tips start above the bed
         lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
         omega = c.shear_speed / rm
         frames, fdir, next_frame = [], Path(frames_dir) if frames_dir else None, [0.0]

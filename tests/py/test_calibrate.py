@@ -111,3 +111,16 @@ def test_shipped_measurements_and_residuals():
     assert abs(res[0].z - 2.0) < 1e-9 and np.isnan(res[1].model)
     assert overall(res)["modelled"] == 1
     assert len(load(ROOT / "data/measurements/jku_angle_of_repose.csv")) == 8
+
+
+def test_surrogate_model_keys_match_measurement_rigs(tmp_path):
+    """Net files are named ring_shear__<metric>.mlp; measurements name the rig ring-shear."""
+    from pydem.compare import surrogate_model
+    from pydem.measurements import Measurement
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0, 1, size=(40, 2))
+    net, _ = select_net("mu_ie_ps", ["a", "b"], x, 0.4 + 0.2 * x[:, 0], sizes=[2], restarts=1)
+    write_weights(net, tmp_path / "ring_shear__mu_ie_ps.mlp")
+    model = surrogate_model(tmp_path, {"a": 0.5, "b": 0.5})
+    res = compare([Measurement("m", "ring_shear", "mu_ie_ps", 0.5, 0.01)], model)
+    assert abs(res[0].model - 0.5) < 0.02
