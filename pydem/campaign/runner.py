@@ -159,15 +159,21 @@ class Campaign:
         # spawn: a fresh interpreter per worker (forking a process that holds OpenMP threads is unsafe)
         with ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=mp.get_context("spawn")) as pool:
             futures = {pool.submit(simulate, *a): i for i, a in args.items()}
+            recorded = set()
             try:
                 for fut in as_completed(futures):
                     self._finish(futures[fut], fut.result(), progress)
+                    recorded.add(fut)
             except BrokenProcessPool:
                 raise StoreError("a worker process died (killed or out of memory); finished runs are saved, the others "
                                  "stay pending: run the campaign again to continue") from None
-            except BaseException:
+            except BaseException:  # Ctrl-C: queued runs are dropped, the ones running are finished and kept
                 for f in futures:
                     f.cancel()
+                pool.shutdown(wait=True)
+                for f in futures:
+                    if f not in recorded and f.done() and not f.cancelled() and f.exception() is None:
+                        self._finish(futures[f], f.result(), progress)
                 raise
 
     def _run_dask(self, address, args, progress):
