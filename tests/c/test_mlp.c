@@ -112,34 +112,27 @@ static void expect_format_error(const char *text, const char *needle)
 
 static void test_malformed_files_are_named(void **state)
 {
-    char *g = golden_text(), *t;
+    /* each case replaces (or, with NULL, drops) one keyword line of the golden file */
+    static const struct { const char *key, *line, *needle; } cases[] = {
+        {"b2", NULL, "'b2' is missing"},
+        {"b1", "b1 1 2 3", "(b1): expected 9 numbers, found 3"},
+        {"w2", "w2 1 2 3 4 5 6 7 8 nan", "(w2): value 9 is not finite"},
+        {"hidden", "hidden 0", "(hidden)"},
+        {"dem-mlp", "dem-mlp 2", "version 2"},
+        {"input_hi", "input_hi 1 0.6 0.2", "restitution"},
+        {"b2", "b2 1 2", "more than"},
+        {"unit", "colour blue", "line 3: unknown keyword 'colour'"},
+    };
+    char *g = golden_text();
     dem_mlp *net = NULL;
     char err[256] = "";
+    size_t k;
     (void)state;
-    t = edit(g, "b2", NULL);
-    expect_format_error(t, "'b2' is missing");
-    free(t);
-    t = edit(g, "b1", "b1 1 2 3");
-    expect_format_error(t, "(b1): expected 9 numbers, found 3");
-    free(t);
-    t = edit(g, "w2", "w2 1 2 3 4 5 6 7 8 nan");
-    expect_format_error(t, "(w2): value 9 is not finite");
-    free(t);
-    t = edit(g, "hidden", "hidden 0");
-    expect_format_error(t, "(hidden)");
-    free(t);
-    t = edit(g, "dem-mlp", "dem-mlp 2");
-    expect_format_error(t, "version 2");
-    free(t);
-    t = edit(g, "input_hi", "input_hi 1 0.6 0.2");
-    expect_format_error(t, "restitution");
-    free(t);
-    t = edit(g, "b2", "b2 1 2");
-    expect_format_error(t, "more than");
-    free(t);
-    t = edit(g, "unit", "colour blue");
-    expect_format_error(t, "line 3: unknown keyword 'colour'");
-    free(t);
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        char *t = edit(g, cases[k].key, cases[k].line);
+        expect_format_error(t, cases[k].needle);
+        free(t);
+    }
     assert_int_equal(dem_mlp_load("tests/data/mlp/no_such_file.mlp", &net, err, sizeof err), DEM_ERR_IO);
     assert_non_null(strstr(err, "no_such_file.mlp"));
     assert_int_equal(dem_mlp_parse(NULL, &net, err, sizeof err), DEM_ERR_NULL);
