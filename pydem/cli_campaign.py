@@ -20,7 +20,7 @@ def add_parser(sub):
     run = csub.add_parser("run", help="create (from a TOML spec) or continue a campaign")
     run.add_argument("spec", nargs="?", help="campaign specification (TOML); not needed to continue a store")
     run.add_argument("--store", required=True, help="the campaign's HDF5 store")
-    run.add_argument("--samples", type=int, help="grow the design to this many samples")
+    run.add_argument("--samples", type=int, help="samples of a new campaign (instead of the spec's), or grow a store to this many")
     run.add_argument("--workers", type=int, help="local worker processes (default: cores / threads per run)")
     run.add_argument("--dask", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     run.add_argument("--retry-failed", action="store_true", help="run the failed samples again")
@@ -43,6 +43,9 @@ def main(args) -> int:
             Campaign.open(args.store).export_csv(args.csv)
             print(f"written {args.csv}")
         else:
+            target = args.samples
+            if target is not None and target < 1:
+                raise SpecError(f"--samples: expected a positive count, got {target}")
             if Path(args.store).exists():
                 c = Campaign.open(args.store)
                 if args.spec:
@@ -50,13 +53,15 @@ def main(args) -> int:
                     if not _same_campaign(spec, c.store.spec):
                         raise SpecError(f"{args.spec} differs from the specification stored in {args.store}; "
                                         "use a new store for a new campaign")
-                    c.grow(spec.samples)
+                    target = target or spec.samples
             elif args.spec:
-                c = Campaign.create(args.store, CampaignSpec.from_toml(args.spec))
+                spec = CampaignSpec.from_toml(args.spec)
+                spec.samples = args.samples or spec.samples  # --samples overrides the spec's count
+                c = Campaign.create(args.store, spec)
             else:
                 raise SpecError(f"{args.store} does not exist: give a campaign spec (TOML) to create it")
-            if args.samples:
-                c.grow(args.samples)
+            if target:
+                c.grow(target)
             counts = c.run(workers=args.workers, dask=args.dask, retry_failed=args.retry_failed,
                            max_runs=args.max_runs, quiet=args.quiet)
             print(f"campaign {args.store}: done {counts['done']}, failed {counts['failed']}, pending {counts['pending']}")
