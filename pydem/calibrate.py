@@ -149,9 +149,20 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
                "overall_surrogate": cmp.overall(res_sur), "overall_dem": cmp.overall(res_dem) if res_dem else None}
     _say("[6/6] report")
     path = report.write(out, summary, trained, sc, cnets, res_sur, res_dem, meas, stores)
-    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+    (out / "summary.json").write_text(json.dumps(_finite(summary), indent=1, default=float))
     _say(f"done in {time.perf_counter() - t_start:.0f} s: {path}")
     return summary
+
+
+def _finite(obj):
+    """NaN -> None, so that summary.json is strict JSON."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj
 
 
 def main_cli(args) -> int:
