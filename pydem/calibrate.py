@@ -147,6 +147,10 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
                         for k, v in trained["meta"].items()},
                "surrogate_at_best": {k: v[0] for k, v in surrogate.items()},
                "overall_surrogate": cmp.overall(res_sur), "overall_dem": cmp.overall(res_dem) if res_dem else None}
+    if len(final):  # the admissible set itself, with the predictions of the screening nets
+        header = ",".join(names + [f"{st.name}:{m.metric}" for st in sc.stages for m in st.measurements])
+        np.savetxt(out / "admissible.csv", np.column_stack([sc.points[final], pred]), delimiter=",", header=header,
+                   comments="", fmt="%.10g")
     _say("[6/6] report")
     path = report.write(out, summary, trained, sc, cnets, res_sur, res_dem, meas, stores)
     (out / "summary.json").write_text(json.dumps(_finite(summary), indent=1, default=float))

@@ -93,7 +93,15 @@ class Campaign:
         path = Path(path)
         if path.exists():
             raise StoreError(f"{path} exists already: run it again to continue, or choose another name")
-        store = CampaignStore(path, spec, provenance())
+        from ..rigs.config import describe
+        prov = provenance()
+        # every knob of the rig as this code resolves the preset (at the centre of the ranges), so
+        # the store says what "preset tiny" meant when it was run
+        centre = {k: 0.5 * (lo + hi) for k, (lo, hi) in spec.ranges.items()}
+        prov["rig_config"] = {key: (value if isinstance(value, (int, float, str, bool)) else str(value))
+                              for key, value, _, _ in describe(spec.config(centre)) if key not in spec.ranges
+                              and key.split(".")[-1] not in spec.ranges}
+        store = CampaignStore(path, spec, prov)
         c = cls(store)
         c.grow(spec.samples)
         store.save()

@@ -42,13 +42,15 @@ def test_calibration_job_end_to_end(aor_campaign, tmp_path):
     summary = calibrate(meas, "beads", [aor_campaign], out, samples=2 ** 14, sizes=[2, 3], restarts=1, threads=2)
     assert set(summary["nets"]) == {"aor__angle_of_repose", "aor__bulk_density"}
     for f in ("report.md", "summary.json", "r2_vs_hidden.csv", "admissible.png", "comparison.png", "parity_holdout.png",
-              "nets/aor__angle_of_repose.mlp", "nets/c/mlp_aor__angle_of_repose.c", "confirm_aor.json"):
+              "nets/aor__angle_of_repose.mlp", "nets/c/mlp_aor__angle_of_repose.c", "confirm_aor.json", "admissible.csv"):
         assert (out / f).exists(), f
     st = summary["stages"][-1]
     assert st["rows"] == 2 ** 14 and 0 < st["admissible"] < 2 ** 14  # the median angle is inside the data
     net = NativeMLP(out / "nets" / "aor__angle_of_repose.mlp")
     pred = net(np.array([list(summary["best"].values())]))[0]
     assert abs(pred - np.median(angles)) <= 0.05 * np.median(angles)  # the best estimate is admissible
+    kept = np.loadtxt(out / "admissible.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert kept.shape == (st["admissible"], 3)  # friction, rolling_friction, the predicted angle
     report = (out / "report.md").read_text()
     assert "Confirming DEM runs" in report and "hold-out R²" in report
     r = subprocess.run([sys.executable, "-m", "pydem", "compare", str(meas), "--material", "beads", "--nets",
