@@ -18,6 +18,7 @@ from . import compare as cmp
 from . import screening
 from .campaign import Campaign
 from .measurements import Measurement, load
+from .rigs import RIGS
 
 PROPERTIES = {"ring-shear": ("mu_ie_ps", "mu_ie_s_", "bulk_density"), "aor": ("angle_of_repose", "bulk_density")}
 STAGE_ORDER = ("ring-shear", "aor")  # screen on the shear tester, then narrow with the heap (seed 000)
@@ -44,7 +45,7 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
             t0 = time.perf_counter()
             net, table = select_net(metric, store.spec.names, x, y, sizes=sizes, restarts=restarts, seed=seed,
                                     unit=store.metric_units[store.metric_names.index(metric)])
-            key = f"{rig.replace('-', '_')}__{metric}"
+            key = cmp.net_key(rig, metric)
             write_weights(net, nets_dir / f"{key}.mlp")
             net.name = key
             write_c(net, nets_dir / "c")
@@ -93,7 +94,7 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     nets_dir = out / "nets"
 
     def net_for(m: Measurement):
-        key = f"{(m.rig or '').replace('-', '_')}__{m.metric}"
+        key = cmp.net_key(m.rig or "", m.metric)
         return NativeMLP(nets_dir / f"{key}.mlp") if (nets_dir / f"{key}.mlp").exists() else None
 
     stages, skipped = [], []
@@ -123,7 +124,6 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     if confirm:
         _say("[5/6] confirming DEM runs at the best estimate")
         for rig, st in stores.items():
-            from .rigs import RIGS
             cfg = st.spec.config(best)
             cfg.num_threads = threads
             t0 = time.perf_counter()

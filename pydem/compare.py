@@ -104,6 +104,11 @@ def plot(res: list[Residual], path: str | Path, title: str = "model vs measureme
     plt.close(fig)
 
 
+def net_key(rig: str, metric: str) -> str:
+    """File stem of an exported property net: ring-shear, mu_ie_ps -> ring_shear__mu_ie_ps."""
+    return f"{rig.replace('-', '_')}__{metric}"
+
+
 def surrogate_model(nets_dir: str | Path, params: dict[str, float]) -> dict[str, tuple[float, float]]:
     """Every exported net in nets_dir (files '<rig>__<metric>.mlp') at one parameter set (libdem
     inference). The uncertainty given is the net's hold-out RMSE when recorded (nets.json)."""
