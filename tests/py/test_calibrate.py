@@ -126,3 +126,19 @@ def test_surrogate_model_keys_match_measurement_rigs(tmp_path):
     model = surrogate_model(tmp_path, {"a": 0.5, "b": 0.5})
     res = compare([Measurement("m", "ring_shear", "mu_ie_ps", 0.5, 0.01)], model)
     assert abs(res[0].model - 0.5) < 0.02
+
+
+def test_command_line_errors_are_clear(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text(HEADER + "x,aor,angle_of_repose,forty,,deg,,calibrate,s\n")
+    r = subprocess.run([sys.executable, "-m", "pydem", "compare", str(bad), "--material", "x", "--dem", "r.json"],
+                       cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 2 and "bad.csv:2, column 'value': expected a number, got 'forty'" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", "--measurements", str(bad), "--material", "x",
+                        "--campaign", str(tmp_path / "none.h5")], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 2 and "bad.csv:2" in r.stderr
+    good = tmp_path / "good.csv"
+    good.write_text(HEADER + "x,aor,angle_of_repose,40,,deg,,calibrate,s\n")
+    r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", "--measurements", str(good), "--material", "x",
+                        "--campaign", str(tmp_path / "none.h5")], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 2 and "none.h5: no such campaign store" in r.stderr
