@@ -74,9 +74,8 @@ def hopper():
 
 
 def plot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from pydem.plotting import pyplot
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     r = rows("aor")

@@ -75,9 +75,8 @@ def table_markdown(res: list[Residual]) -> str:
 def plot(res: list[Residual], path: str | Path, title: str = "model vs measurements", extra: dict | None = None):
     """One panel per quantity: measured (with uncertainty) and model values against the condition.
     extra: other models to overlay, {label: list[Residual]}."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from .plotting import pyplot
+    plt = pyplot()
     groups: dict[str, list[int]] = {}
     for i, r in enumerate(res):
         groups.setdefault(f"{r.m.test}:{r.m.quantity}", []).append(i)

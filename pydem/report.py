@@ -7,17 +7,12 @@ from pathlib import Path
 import numpy as np
 
 from . import compare as cmp
+from .plotting import pyplot
 
-
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 def plot_r2(tables: dict, path: Path):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for key, table in tables.items():
         ax.plot([r["hidden"] for r in table], [r["best_holdout_r2"] for r in table], "o-", ms=3, label=key)
@@ -32,7 +27,7 @@ def plot_r2(tables: dict, path: Path):
 
 
 def plot_parity(meta: dict, path: Path):
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(meta), figsize=(3.2 * len(meta), 3.2), squeeze=False)
     for ax, (key, m) in zip(axes[0], meta.items()):
         s, p = np.array(m["parity"]["simulated"]), np.array(m["parity"]["predicted"])
@@ -48,7 +43,7 @@ def plot_parity(meta: dict, path: Path):
 
 
 def plot_admissible(sc, path: Path):
-    plt = _plt()
+    plt = pyplot()
     names = sc.names
     pairs = [(i, j) for i in range(len(names)) for j in range(i + 1, len(names))]
     fig, axes = plt.subplots(1, len(pairs), figsize=(3.6 * len(pairs), 3.4), squeeze=False)
@@ -72,7 +67,7 @@ def plot_admissible(sc, path: Path):
 def plot_predicted_vs_measured(sc, nets, meas, window: float, path: Path):
     """Per screened quantity: the surrogate's predictions over the final admissible set (and over
     all combinations), against the measured value and the window."""
-    plt = _plt()
+    plt = pyplot()
     if not nets:
         return False
     fig, axes = plt.subplots(1, len(nets), figsize=(3.4 * len(nets), 3.2), squeeze=False)

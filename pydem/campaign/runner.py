@@ -15,7 +15,7 @@ import numpy as np
 
 from .design import design_points
 from .spec import CampaignSpec
-from .store import DONE, FAILED, CampaignStore, StoreError
+from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError
 
 
 def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
@@ -225,6 +225,6 @@ class Campaign:
             w.writerow(["index", "seed", "status"] + s.spec.names + s.metric_names
                        + [m + "_uncertainty" for m in s.metric_names] + ["wall_seconds", "error"])
             for i in range(len(s)):
-                w.writerow([i, int(s.seeds[i]), ("pending", "done", "failed")[s.status[i]]]
+                w.writerow([i, int(s.seeds[i]), STATUS_NAMES[int(s.status[i])]]
                            + [repr(float(x)) for x in s.params[i]] + [repr(float(x)) for x in s.values[i]]
                            + [repr(float(x)) for x in s.uncertainty[i]] + [repr(float(s.wall[i])), s.errors[i]])

@@ -23,6 +23,11 @@ PENDING, DONE, FAILED = 0, 1, 2
 STATUS_NAMES = {PENDING: "pending", DONE: "done", FAILED: "failed"}
 
 
+def _strings(dataset) -> list[str]:
+    """An h5py string dataset as Python strings (h5py returns bytes for variable-length strings)."""
+    return [x.decode() if isinstance(x, bytes) else str(x) for x in dataset[()]]
+
+
 class StoreError(RuntimeError):
     """A campaign store that cannot be read, written or locked."""
 
@@ -159,9 +164,9 @@ class CampaignStore:
                 s.params = f["parameters"][()]
                 s.seeds, s.status = f["seed"][()], f["status"][()]
                 s.wall, s.finished_at = f["wall_seconds"][()], f["finished_at"][()]
-                s.errors = [x.decode() if isinstance(x, bytes) else str(x) for x in f["error"][()]]
-                s.metric_names = [x.decode() if isinstance(x, bytes) else str(x) for x in f["metric_names"][()]]
-                s.metric_units = [x.decode() if isinstance(x, bytes) else str(x) for x in f["metric_units"][()]]
+                s.errors = _strings(f["error"])
+                s.metric_names = _strings(f["metric_names"])
+                s.metric_units = _strings(f["metric_units"])
                 s.values, s.uncertainty = f["metrics"][()], f["metric_uncertainty"][()]
         except StoreError:
             raise
