@@ -55,6 +55,11 @@ typedef struct mesh_wall {
     dem_servo_def servo;
     double servo_force;      /* filtered measured force along -direction, N */
     int servo_primed;        /* the filter has seen a first value */
+    /* time average of the wall force (mesh_mean_force.c): integrals since the last reset */
+    int averaging;           /* accumulate every step */
+    double impulse[3];       /* sum of F dt, N s */
+    double moment_impulse[3];/* sum of (x - 0) x F dt about the origin, N m s */
+    double averaged_time;    /* sum of dt, s */
 } mesh_wall;
 
 /* Mesh-triangle contact candidates, grouped by particle (CSR over particles). An entry is
@@ -216,6 +221,8 @@ void dem_mesh_update_world(mesh_wall *m);
 int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x, const double *r, int *which_mesh);
 /* force the particles exert on mesh m during the last step (N) */
 void dem_mesh_total_force(const dem_domain *d, int m, double force[3]);
+/* mesh_mean_force.c: add the force of the step just computed, times dt, to every averaging mesh */
+void dem_meshes_accumulate_mean_force(dem_domain *d, double dt);
 
 /* step.c */
 double dem_rayleigh_time(dem_domain *d);

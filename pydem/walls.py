@@ -122,6 +122,18 @@ class MeshWall:
         self.domain._check(lib.dem_mesh_wall_force(self.domain._d, self.index, ffi.new("double[3]", list(point)), f, t))
         return np.array(list(f)), np.array(list(t))
 
+    def reset_mean_force(self) -> None:
+        """Starts (or restarts) the time average of the wall force read by mean_force."""
+        self.domain._check(lib.dem_mesh_wall_reset_mean_force(self.domain._d, self.index))
+
+    def mean_force(self, point: Sequence[float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray, float]:
+        """(force, torque about point, seconds): the wall force averaged over every step since
+        reset_mean_force, and the time averaged (0 with zero force when no step was taken)."""
+        f, t, sec = ffi.new("double[3]"), ffi.new("double[3]"), ffi.new("double *")
+        self.domain._check(lib.dem_mesh_wall_mean_force(self.domain._d, self.index, ffi.new("double[3]", list(point)),
+                                                        f, t, sec))
+        return np.array(list(f)), np.array(list(t)), float(sec[0])
+
     def triangle_forces(self) -> np.ndarray:
         out = np.empty((self.info()["triangle_count"], 3))
         self.domain._check(lib.dem_mesh_wall_triangle_forces(self.domain._d, self.index, _ptr(out, "double[]")))

@@ -87,6 +87,13 @@ DEM_API dem_status dem_mesh_wall_get_velocity(const dem_domain *domain, int mesh
  * about `point` (N m); point NULL: the origin. */
 DEM_API dem_status dem_mesh_wall_force(const dem_domain *domain, int mesh, const double point[3], double force[3],
                                        double torque[3]);
+/* Time average of the wall force over every step since the last reset: a lid's stress without
+ * the step-to-step rattle of a snapshot. Reset starts (or restarts) the average; the mean is
+ * sum(F dt) / sum(dt) and its torque about `point` (NULL: the origin); `seconds` receives the
+ * averaged time (0, and zero force, when no step was taken since the reset). */
+DEM_API dem_status dem_mesh_wall_reset_mean_force(dem_domain *domain, int mesh);
+DEM_API dem_status dem_mesh_wall_mean_force(const dem_domain *domain, int mesh, const double point[3],
+                                            double force[3], double torque[3], double *seconds);
 /* Force on each triangle, 3 x triangle_count (N). */
 DEM_API dem_status dem_mesh_wall_triangle_forces(const dem_domain *domain, int mesh, double *forces);
 /* Normal and shear stress of the wall force over `area` (m^2) for the unit `normal`:

@@ -3,9 +3,11 @@ with bars; the lid is held against rotation and servo-loaded to a normal stress;
 stress comes from the lid torque about the axis, tau = T / integral(r dA) = 3 T / (2 pi
 (Ro^3 - Ri^3)), the normal stress from the lid force over its area.
 
-Procedure (DESIGN section 6): pre-shear at sigma_pre to steady flow -> tau_pre; then for each
-shear point (40/60/80 % of sigma_pre): a fresh pre-shear, stop, reduce the load to sigma_sh,
-shear again until failure -> tau_sh (the peak). Outputs mu_ie-ps = tau_pre / sigma_pre,
+Procedure (DESIGN section 6): pre-shear at sigma_pre to steady flow; then for each shear point
+(40/60/80 % of sigma_pre): a fresh pre-shear, stop, reduce the load to sigma_sh, shear again
+until failure -> tau_sh (the peak). tau_pre: the mean over the steady halves of all pre-shears.
+Lid stresses are time averages of the wall force between samples (libdem's mean wall force),
+not snapshots. Outputs mu_ie-ps = tau_pre / sigma_pre,
 mu_ie-s = tau_sh / sigma_sh per point, the yield locus (least-squares line through the shear
 points: slope and intercept), bulk density under the lid, and the inertial number reached,
 I = gamma_dot d / sqrt(sigma_pre / rho_s) with gamma_dot = (omega R_mean) / bed height.
@@ -109,12 +111,18 @@ class RingShear:
         v = lid_mesh[0].copy()
         v[:, 2] += top + dm + max(0.0, c.bar_height - 0.8 * dm)  # bar tips start above the bed
         lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
+        lid.reset_mean_force()
         omega = c.shear_speed / rm
         frames, fdir, next_frame = [], Path(frames_dir) if frames_dir else None, [0.0]
         phase_log = []
 
         def lid_state():
-            f, t = lid.force((0.0, 0.0, 0.0))
+            """Lid stresses averaged over the steps since the previous sample (a snapshot rattles
+            by tens of per cent from step to step)."""
+            f, t, seconds = lid.mean_force((0.0, 0.0, 0.0))
+            if seconds == 0.0:
+                f, t = lid.force((0.0, 0.0, 0.0))
+            lid.reset_mean_force()
             return f[2] / area, t[2] / moment  # sigma: particles push the lid up; tau: they drag it along +omega
 
         def sample(tag):
@@ -143,10 +151,11 @@ class RingShear:
             st.advance(max_seconds, chunk=2e-3, each=settled)
 
         def preshear(displacement):
-            """Shears at sigma_pre until steady (or max_preshear); returns tau samples of the steady part."""
+            """Shears at sigma_pre until steady (or max_preshear); returns the tau, sigma and lid
+            height samples of the steady part (its second half)."""
             trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
             start = len(st.series.get("tau", []))
-            chunk = min(0.25 * displacement / c.shear_speed, 0.05)
+            chunk = min(0.05 * displacement / c.shear_speed, 0.01)  # >= 20 samples: quarters of 5+
             st.advance(displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
             total = displacement
             while True:
@@ -159,11 +168,9 @@ class RingShear:
                 st.advance(0.25 * displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
                 total += 0.25 * displacement
             trough.set_motion((0, 0, 0))
-            taus = np.array(st.series["tau"][start:])
-            sig = np.array(st.series["sigma"][start:])
-            half = len(taus) // 2
+            half = start + (len(st.series["tau"]) - start) // 2
             phase_log.append(("preshear", total))
-            return taus[half:], sig[half:]
+            return tuple(np.array(st.series[k][half:]) for k in ("tau", "sigma", "lid_z"))
 
         def shear_to_failure():
             trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
@@ -186,23 +193,26 @@ class RingShear:
             return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
 
         load_to(c.preshear_stress, 1.0)
-        steady, sig_steady = preshear(c.first_preshear_displacement)
-        tau_pre, tau_pre_se = block_average(steady, 4)
-        sigma_pre = float(np.mean(sig_steady))
-        z_lid = float(np.mean(st.series["lid_z"][-len(steady):]))
+        steady = [preshear(c.first_preshear_displacement)]
         mass = float(np.sum(p.density * 4 / 3 * math.pi * d.radii ** 3))
         res = RigResult("ring-shear")
         points = []
         for frac in c.shear_points:
-            s_pre, _ = preshear(c.preshear_displacement)
+            steady.append(preshear(c.preshear_displacement))
             load_to(frac * c.preshear_stress)
             tau_sh, sigma_sh = shear_to_failure()
-            points.append((frac, sigma_sh, tau_sh, float(np.mean(s_pre))))
+            points.append((frac, sigma_sh, tau_sh))
             load_to(c.preshear_stress)
-        res.metrics["tau_preshear"] = Metric(tau_pre, tau_pre_se, "Pa", "steady half of the first pre-shear")
+        # every pre-shear ends in the same steady flow: tau_pre, sigma_pre and the density are
+        # means over the steady parts of all of them (as a Schulze tester's operator averages)
+        tau_steady, sig_steady, z_steady = (np.concatenate([part[k] for part in steady]) for k in range(3))
+        tau_pre, tau_pre_se = block_average(tau_steady, 4)
+        sigma_pre = float(np.mean(sig_steady))
+        z_lid = float(np.mean(z_steady))
+        res.metrics["tau_preshear"] = Metric(tau_pre, tau_pre_se, "Pa", "steady halves of all pre-shears")
         res.metrics["sigma_preshear"] = Metric(sigma_pre, float(np.std(sig_steady) / math.sqrt(4)), "Pa", "lid")
         res.metrics["mu_ie_ps"] = Metric(tau_pre / sigma_pre, tau_pre_se / sigma_pre, "", "tau_pre / sigma_pre")
-        for frac, s, t, _ in points:
+        for frac, s, t in points:
             res.metrics[f"mu_ie_s_{int(round(frac * 100))}"] = Metric(t / s, math.nan, "", f"peak tau / sigma at {frac:.0%}")
             res.metrics[f"tau_shear_{int(round(frac * 100))}"] = Metric(t, math.nan, "Pa", f"sigma_sh = {s:.0f} Pa")
         if len(points) >= 2:
@@ -217,7 +227,7 @@ class RingShear:
         res.frames = [f for f in frames if f]
         res.info = {"particles": c.particles, "steps": st.steps, "dt": d.dt, "simulated_time": d.time,
                     "wall_seconds": st.wall_seconds(), "seed": seed, "phases": phase_log,
-                    "shear_points": [{"fraction": f, "sigma": s, "tau_peak": t} for f, s, t, _ in points]}
+                    "shear_points": [{"fraction": f, "sigma": s, "tau_peak": t} for f, s, t in points]}
         return res
 
     def _planned_time(self) -> float:

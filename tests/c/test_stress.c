@@ -96,6 +96,48 @@ static void test_column_weight_on_walls(void **state)
     dem_domain_destroy(d);
 }
 
+/* The time-averaged wall force equals the mean of the per-step forces (to rounding: the
+ * same sums), its torque follows M_p = M_0 - p x F, and over a settled column it is the
+ * weight (momentum balance, 0.1 % as above). */
+static void test_mean_wall_force(void **state)
+{
+    (void)state;
+    int box, mat;
+    int64_t n;
+    dem_domain *d = column(&box, &mat, &n, 0.3);
+    double f[3], t[3], sec = -1.0;
+    assert_ok(dem_mesh_wall_reset_mean_force(d, box));
+    assert_ok(dem_mesh_wall_mean_force(d, box, NULL, f, t, &sec));
+    assert_true(sec == 0.0 && f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0); /* no step yet */
+    assert_int_equal(dem_mesh_wall_reset_mean_force(d, 7), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_mesh_wall_mean_force(d, -1, NULL, f, t, &sec), DEM_ERR_UNKNOWN_WALL);
+    assert_ok(dem_domain_step(d, 20000)); /* falling and settling: a rattling force */
+    const double p[3] = {0.003, 0.002, 0.001};
+    double fs[3] = {0, 0, 0}, ts[3] = {0, 0, 0};
+    const int steps = 300;
+    assert_ok(dem_mesh_wall_reset_mean_force(d, box));
+    for (int s = 0; s < steps; s++) {
+        assert_ok(dem_domain_step(d, 1));
+        assert_ok(dem_mesh_wall_force(d, box, p, f, t));
+        for (int a = 0; a < 3; a++) {
+            fs[a] += f[a] / steps;
+            ts[a] += t[a] / steps;
+        }
+    }
+    assert_ok(dem_mesh_wall_mean_force(d, box, p, f, t, &sec));
+    assert_close(sec, steps * 5e-6, 1e-12, 0);
+    for (int a = 0; a < 3; a++) {
+        assert_close(f[a], fs[a], 1e-9, 1e-12 * fabs(fs[2]));
+        assert_close(t[a], ts[a], 1e-9, 1e-12 * fabs(fs[2]) * L);
+    }
+    assert_ok(dem_domain_step(d, 20000)); /* settled */
+    assert_ok(dem_mesh_wall_reset_mean_force(d, box));
+    assert_ok(dem_domain_step(d, 2000));
+    assert_ok(dem_mesh_wall_mean_force(d, box, NULL, f, NULL, NULL));
+    assert_close(-f[2], total_weight(d, n), 1e-3, 0);
+    dem_domain_destroy(d);
+}
+
 static void test_servo_lid_and_region_stress(void **state)
 {
     (void)state;
@@ -208,6 +250,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_single_sphere_closed_form),
         cmocka_unit_test(test_column_weight_on_walls),
+        cmocka_unit_test(test_mean_wall_force),
         cmocka_unit_test(test_servo_lid_and_region_stress),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
