@@ -33,7 +33,7 @@ def property_metrics(rig: str, store) -> list[str]:
     return [m for m in store.metric_names if any(m == w or (w.endswith("_") and m.startswith(w)) for w in wanted)]
 
 
-def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
+def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selection: str = "one-se") -> dict:
     from nn.export import write_c, write_weights
     from nn.mlp import select_net
     nets_dir = out / "nets"
@@ -44,7 +44,7 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
             x, y, _ = store.table(metric)
             t0 = time.perf_counter()
             net, table = select_net(metric, store.spec.names, x, y, sizes=sizes, restarts=restarts, seed=seed,
-                                    unit=store.metric_units[store.metric_names.index(metric)])
+                                    unit=store.metric_units[store.metric_names.index(metric)], rule=selection)
             key = cmp.net_key(rig, metric)
             write_weights(net, nets_dir / f"{key}.mlp")
             net.name = key
@@ -52,11 +52,13 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
             i = net.info
             meta[key] = {"rig": rig, "metric": metric, "hidden": net.hidden, "unit": net.unit,
                          "seconds": time.perf_counter() - t0,
-                         **{k: i[k] for k in ("holdout_r2", "train_r2", "samples", "holdout_samples", "holdout_rmse")},
+                         **{k: i[k] for k in ("holdout_r2", "train_r2", "samples", "holdout_samples", "holdout_rmse", "selection",
+                                     "best_hidden", "best_holdout_r2", "holdout_r2_se")},
                          "parity": {"simulated": i["holdout_simulated"], "predicted": i["holdout_predicted"]}}
             tables[key] = table
-            _say(f"  {key:32s} hidden {net.hidden:3d}   hold-out R^2 {net.info['holdout_r2']:.4f}   "
-                 f"({net.info['samples']} runs, {time.perf_counter() - t0:.1f} s)")
+            _say(f"  {key:32s} hidden {net.hidden:3d}   hold-out R^2 {i['holdout_r2']:.4f}   (best: {i['best_hidden']} "
+                 f"units, {i['best_holdout_r2']:.4f} +- {i['holdout_r2_se']:.4f}; {i['samples']} runs, "
+                 f"{time.perf_counter() - t0:.1f} s)")
     (nets_dir / "nets.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if kk != "parity"}
                                                     for k, v in meta.items()}, indent=1))
     with open(out / "r2_vs_hidden.csv", "w") as fh:
@@ -70,7 +72,7 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int) -> dict:
 
 def calibrate(measurements: str | Path, material: str, campaigns: list[str | Path], out: str | Path,
               window: float = 0.05, samples: int = 2 ** 20, sizes=range(2, 41, 2), restarts: int = 3,
-              threads: int = 2, seed: int = 0, confirm: bool = True) -> dict:
+              threads: int = 2, seed: int = 0, confirm: bool = True, selection: str = "one-se") -> dict:
     from .mlp import NativeMLP
     from . import report
     t_start = time.perf_counter()
@@ -89,8 +91,9 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     ranges = {n: (max(st.spec.ranges[n][0] for st in stores.values()), min(st.spec.ranges[n][1] for st in stores.values()))
               for n in names}
     _say(f"[1/6] campaigns: " + ", ".join(f"{rig} {st.counts()['done']} runs ({st.path.name})" for rig, st in stores.items()))
-    _say(f"[2/6] training one MLP per property (hidden sizes {min(sizes)}-{max(sizes)}, {restarts} restarts, 15 % hold-out)")
-    trained = train_all(stores, out, list(sizes), restarts, seed)
+    _say(f"[2/6] training one MLP per property (hidden sizes {min(sizes)}-{max(sizes)}, {restarts} restarts, 15 % hold-out, "
+         f"selection {selection})")
+    trained = train_all(stores, out, list(sizes), restarts, seed, selection)
     nets_dir = out / "nets"
 
     def net_for(m: Measurement):
@@ -174,7 +177,7 @@ def main_cli(args) -> int:
     from .campaign import StoreError
     try:
         calibrate(args.measurements, args.material, args.campaign, args.out, window=args.window, samples=args.samples,
-                  restarts=args.restarts, threads=args.threads, confirm=not args.no_confirm)
+                  restarts=args.restarts, threads=args.threads, confirm=not args.no_confirm, selection=args.selection)
     except (MeasurementError, StoreError, ValueError) as exc:
         print(f"pydem calibrate: {exc}", file=sys.stderr)
         return 2
@@ -190,6 +193,8 @@ def add_parser(sub):
     p.add_argument("--window", type=float, default=0.05, help="relative acceptance window (default 0.05 = 5 %%)")
     p.add_argument("--samples", type=int, default=2 ** 20, help="combinations screened (default 2^20)")
     p.add_argument("--restarts", type=int, default=3)
+    p.add_argument("--selection", choices=("one-se", "best"), default="one-se",
+                   help="hidden size: smallest within one standard error of the best hold-out R^2 (default), or the best")
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--no-confirm", action="store_true", help="skip the confirming DEM runs")
     p.set_defaults(func=main_cli)

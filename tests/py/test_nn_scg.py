@@ -3,6 +3,7 @@ minimised in <= N successful steps (conjugate directions with exact curvature), 
 minimum (1, 1) is reached, and on a small regression SCG needs fewer iterations than plain
 gradient descent with its best fixed step."""
 import numpy as np
+import pytest
 import torch
 
 from nn.mlp import MLP, Scaler, r2_score, select_net, train_net
@@ -95,11 +96,27 @@ def test_selection_fits_a_smooth_property_and_writes_the_table():
     rng = np.random.default_rng(3)
     x = rng.uniform([0.05, 0.0], [1.0, 0.6], size=(120, 2))
     y = 0.3 + 0.2 * np.tanh(3 * x[:, 0]) + 0.3 * x[:, 1]  # noise-free: R^2 must be near 1
-    net, table = select_net("p", ["friction", "rolling_friction"], x, y, sizes=[2, 4, 6], restarts=2, seed=5)
+    net, table = select_net("p", ["friction", "rolling_friction"], x, y, sizes=[2, 4, 6], restarts=2, seed=5,
+                            rule="best")
     assert [r["hidden"] for r in table] == [2, 4, 6]
     assert net.info["holdout_r2"] == max(r["best_holdout_r2"] for r in table)
     assert net.info["holdout_r2"] > 0.99
     assert abs(r2_score(y, net.predict(x)) - 1) < 0.02
+
+
+def test_one_se_rule_keeps_the_smallest_size_within_the_noise_of_the_best():
+    rng = np.random.default_rng(11)
+    x = rng.uniform([0.05, 0.0], [1.0, 0.6], size=(120, 2))
+    y = 0.3 + 0.2 * x[:, 0] + 0.3 * x[:, 1] + rng.normal(0, 0.03, 120)  # plane + noise: any size fits it
+    net, table = select_net("p", ["friction", "rolling_friction"], x, y, sizes=[2, 8, 14, 20], restarts=2, seed=5)
+    i = net.info
+    best = max(r["best_holdout_r2"] for r in table)
+    assert i["selection"] == "one-se" and i["best_holdout_r2"] == best and 0 < i["holdout_r2_se"] < 0.2
+    first_within = next(r for r in table if r["best_holdout_r2"] >= best - i["holdout_r2_se"])
+    assert net.hidden == first_within["hidden"] and i["holdout_r2"] == first_within["best_holdout_r2"]
+    assert net.hidden <= i["best_hidden"]
+    with pytest.raises(ValueError, match="selection rule"):
+        select_net("p", ["friction", "rolling_friction"], x, y, sizes=[2], restarts=1, rule="smallest")
 
 
 def test_scaler_round_trip_and_constant_column():
