@@ -123,7 +123,13 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
          + ("" if len(final) else "   (no admissible combination: the least misfit shown)"))
     _say("[4/6] predictions of every net at the best estimate and over the admissible set")
     surrogate = cmp.surrogate_model(nets_dir, best)
-    dem_files = []
+    dem_files, protocol_notes = [], []
+    for rig, st in stores.items():
+        made_with, now = int(st.provenance.get("rig_protocol", 1)), RIGS[rig][0].protocol
+        if made_with != now:
+            protocol_notes.append(f"{rig}: the campaign was measured with rig protocol {made_with}, the confirming run "
+                                  f"with protocol {now} (the metric definitions changed since; see the rig's notes)")
+            _say(f"  note: {protocol_notes[-1]}")
     if confirm:
         _say("[5/6] confirming DEM runs at the best estimate")
         for rig, st in stores.items():
@@ -145,7 +151,7 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
                "stages": [{"name": st.name, "measured": [m.label for m in st.measurements], "rows": st.rows,
                            "admissible": int(len(idx)), "seconds": st.seconds, "ranges": sc.ranges_of(idx)}
                           for st, idx in zip(sc.stages, sc.admissible)],
-               "skipped_measurements": [m.label for m in skipped],
+               "skipped_measurements": [m.label for m in skipped], "protocol_notes": protocol_notes,
                "nets": {k: {kk: v[kk] for kk in ("hidden", "holdout_r2", "train_r2", "samples", "holdout_rmse")}
                         for k, v in trained["meta"].items()},
                "surrogate_at_best": {k: v[0] for k, v in surrogate.items()},

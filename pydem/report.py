@@ -173,6 +173,7 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
     L += ["", "## Model vs measurements", "", "### Surrogate at the best estimate", "", cmp.table_markdown(res_sur), ""]
     if res_dem:
         L += ["### Confirming DEM runs at the best estimate", "", cmp.table_markdown(res_dem), ""]
+        L += [f"Note — {n}." for n in summary.get("protocol_notes", [])] + ([""] if summary.get("protocol_notes") else [])
     L += ["![comparison](comparison.png)", ""]
     L += ["Nets exported to `nets/` (libdem weights files, `*.mlp`) and `nets/c/` (standalone C99 source/header); "
           "R² against hidden size in `r2_vs_hidden.csv`; everything above in `summary.json`."]

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..rigs import RIGS
 from .design import design_points
 from .spec import CampaignSpec
 from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError
@@ -95,6 +96,7 @@ class Campaign:
             raise StoreError(f"{path} exists already: run it again to continue, or choose another name")
         from ..rigs.config import describe
         prov = provenance()
+        prov["rig_protocol"] = RIGS[spec.rig][0].protocol
         # every knob of the rig as this code resolves the preset (at the centre of the ranges), so
         # the store says what "preset tiny" meant when it was run
         centre = {k: 0.5 * (lo + hi) for k, (lo, hi) in spec.ranges.items()}
@@ -126,6 +128,13 @@ class Campaign:
             max_runs: int | None = None, quiet: bool = False) -> dict[str, int]:
         """Runs the pending samples (and failed ones with retry_failed); saves after each."""
         s = self.store
+        rig_cls = RIGS[s.spec.rig][0]
+        made_with = int(s.provenance.get("rig_protocol", 1))  # stores from before the stamp: protocol 1
+        if made_with != rig_cls.protocol:
+            raise StoreError(f"{s.path}: its runs were measured with {s.spec.rig} protocol {made_with}, this code measures "
+                             f"with protocol {rig_cls.protocol} (see the rig's `protocol` note); adding runs would mix two "
+                             f"definitions of the metrics in one data set. Start a new store, or continue it from commit "
+                             f"{s.provenance.get('git_commit', 'unknown')}.")
         s.lock()
         try:
             todo = s.pending(retry_failed)[:max_runs]
@@ -208,7 +217,8 @@ class Campaign:
         lines.append("  ranges: " + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in spec.ranges.items()))
         if spec.fixed:
             lines.append("  fixed: " + ", ".join(f"{k}={v}" for k, v in spec.fixed.items()))
-        lines.append("  metrics: " + (", ".join(s.metric_names) or "none yet"))
+        lines.append(f"  metrics: " + (", ".join(s.metric_names) or "none yet") +
+                     f" (rig protocol {s.provenance.get('rig_protocol', 1)}; this code: {RIGS[spec.rig][0].protocol})")
         for i in np.flatnonzero(s.status == FAILED)[:10]:
             lines.append(f"  failed #{i}: {s.errors[i]}")
         p = s.provenance

@@ -52,6 +52,7 @@ class AorConfig:
 
 class AngleOfRepose:
     name = "aor"
+    protocol = 1  # raised whenever a metric's definition changes (campaigns refuse to mix protocols)
 
     def __init__(self, config: AorConfig | None = None):
         self.config = config or AorConfig.preset("default")

@@ -121,6 +121,7 @@ def species_counts(n: int, d_small: float, d_large: float, fine_fraction: float)
 
 class Hopper:
     name = "hopper"
+    protocol = 1  # raised whenever a metric's definition changes (campaigns refuse to mix protocols)
 
     def __init__(self, config: HopperConfig | None = None):
         self.config = config or HopperConfig.preset("default")

@@ -66,6 +66,9 @@ class RingShearConfig:
 
 class RingShear:
     name = "ring-shear"
+    # raised whenever a metric's definition changes (campaigns refuse to mix protocols):
+    # 1: lid snapshots, tau_pre from the first pre-shear; 2: lid time averages, tau_pre over all pre-shears
+    protocol = 2
 
     def __init__(self, config: RingShearConfig | None = None):
         self.config = config or RingShearConfig.preset("default")

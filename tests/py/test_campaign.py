@@ -120,6 +120,12 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
     with pytest.raises(StoreError, match="being written by another"):
         Campaign.open(tmp_path / "s.h5").run(quiet=True)
     other.store.unlock()
+    # a store measured under another definition of the metrics is not extended silently
+    assert c.store.provenance["rig_protocol"] == 1
+    c.store.provenance["rig_protocol"] = 0
+    c.store.save()
+    with pytest.raises(StoreError, match="protocol 0, this code measures with protocol 1"):
+        Campaign.open(tmp_path / "s.h5").run(quiet=True)
     (tmp_path / "junk.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     with pytest.raises(StoreError, match="unreadable campaign store"):
         CampaignStore.open(tmp_path / "junk.h5")
