@@ -125,7 +125,7 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     surrogate = cmp.surrogate_model(nets_dir, best)
     dem_files, protocol_notes = [], []
     for rig, st in stores.items():
-        made_with, now = int(st.provenance.get("rig_protocol", 1)), RIGS[rig][0].protocol
+        made_with, now = st.rig_protocol, RIGS[rig][0].protocol
         if made_with != now:
             protocol_notes.append(f"{rig}: the campaign was measured with rig protocol {made_with}, the confirming run "
                                   f"with protocol {now} (the metric definitions changed since; see the rig's notes)")
@@ -151,7 +151,7 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
                "stages": [{"name": st.name, "measured": [m.label for m in st.measurements], "rows": st.rows,
                            "admissible": int(len(idx)), "seconds": st.seconds, "ranges": sc.ranges_of(idx)}
                           for st, idx in zip(sc.stages, sc.admissible)],
-               "skipped_measurements": [m.label for m in skipped], "protocol_notes": protocol_notes,
+               "skipped_measurements": [m.label for m in skipped], "protocol_notes": protocol_notes, "selection": selection,
                "nets": {k: {kk: v[kk] for kk in ("hidden", "holdout_r2", "train_r2", "samples", "holdout_rmse")}
                         for k, v in trained["meta"].items()},
                "surrogate_at_best": {k: v[0] for k, v in surrogate.items()},

@@ -10,7 +10,6 @@ from . import compare as cmp
 from .plotting import pyplot
 
 
-
 def plot_r2(tables: dict, path: Path):
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6))
@@ -113,7 +112,7 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
           "early stopping; sizes 2–40 are compared on a fixed, seeded 15 % hold-out (so the hold-out R² is slightly "
           "optimistic: it also chose the size). Selection rule: " +
           ("the smallest size within one standard error of the best hold-out R² (the curve is flat within its noise; "
-           "small nets screen faster)" if next(iter(trained["meta"].values()), {}).get("selection") == "one-se"
+           "small nets screen faster)" if summary.get("selection") == "one-se"
            else "the size with the best hold-out R²") + ".", "",
           "| net | runs | hidden | hold-out R² | train R² | hold-out RMSE | best size: hidden, R² ± SE |",
           "|---|---|---|---|---|---|---|"]

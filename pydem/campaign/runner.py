@@ -129,7 +129,7 @@ class Campaign:
         """Runs the pending samples (and failed ones with retry_failed); saves after each."""
         s = self.store
         rig_cls = RIGS[s.spec.rig][0]
-        made_with = int(s.provenance.get("rig_protocol", 1))  # stores from before the stamp: protocol 1
+        made_with = s.rig_protocol
         if made_with != rig_cls.protocol:
             raise StoreError(f"{s.path}: its runs were measured with {s.spec.rig} protocol {made_with}, this code measures "
                              f"with protocol {rig_cls.protocol} (see the rig's `protocol` note); adding runs would mix two "
@@ -218,7 +218,7 @@ class Campaign:
         if spec.fixed:
             lines.append("  fixed: " + ", ".join(f"{k}={v}" for k, v in spec.fixed.items()))
         lines.append(f"  metrics: " + (", ".join(s.metric_names) or "none yet") +
-                     f" (rig protocol {s.provenance.get('rig_protocol', 1)}; this code: {RIGS[spec.rig][0].protocol})")
+                     f" (rig protocol {s.rig_protocol}; this code: {RIGS[spec.rig][0].protocol})")
         for i in np.flatnonzero(s.status == FAILED)[:10]:
             lines.append(f"  failed #{i}: {s.errors[i]}")
         p = s.provenance

@@ -88,6 +88,11 @@ class CampaignStore:
         todo = (self.status == PENDING) | ((self.status == FAILED) if retry_failed else False)
         return [int(i) for i in np.flatnonzero(todo)]
 
+    @property
+    def rig_protocol(self) -> int:
+        """The rig protocol the runs were measured with (stores from before the stamp: 1)."""
+        return int(self.provenance.get("rig_protocol", 1))
+
     def counts(self) -> dict[str, int]:
         return {name: int((self.status == s).sum()) for s, name in STATUS_NAMES.items()}
 
