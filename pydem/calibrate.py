@@ -41,7 +41,11 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selectio
     meta, tables = {}, {}
     for rig, store in stores.items():
         for metric in property_metrics(rig, store):
-            x, y, _ = store.table(metric)
+            # replicates averaged: the nets fit (and are judged on) each design point's mean
+            x, y, counts, replicate_sd = store.point_table(metric)
+            # the R^2 a perfect net would get on these means: their replicate noise over their variance
+            noise_var = replicate_sd ** 2 * float(np.mean(1.0 / counts))
+            ceiling = 1.0 - noise_var / float(np.var(y)) if np.isfinite(replicate_sd) and np.var(y) > 0 else float("nan")
             t0 = time.perf_counter()
             net, table = select_net(metric, store.spec.names, x, y, sizes=sizes, restarts=restarts, seed=seed,
                                     unit=store.metric_units[store.metric_names.index(metric)], rule=selection)
@@ -51,13 +55,15 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selectio
             write_c(net, nets_dir / "c")
             i = net.info
             meta[key] = {"rig": rig, "metric": metric, "hidden": net.hidden, "unit": net.unit,
+                         "runs": int(counts.sum()), "replicates": float(np.mean(counts)),
+                         "replicate_sd": replicate_sd, "r2_noise_ceiling": ceiling,
                          "seconds": time.perf_counter() - t0,
                          **{k: i[k] for k in ("holdout_r2", "train_r2", "samples", "holdout_samples", "holdout_rmse", "selection",
                                      "best_hidden", "best_holdout_r2", "holdout_r2_se")},
                          "parity": {"simulated": i["holdout_simulated"], "predicted": i["holdout_predicted"]}}
             tables[key] = table
             _say(f"  {key:32s} hidden {net.hidden:3d}   hold-out R^2 {i['holdout_r2']:.4f}   (best: {i['best_hidden']} "
-                 f"units, {i['best_holdout_r2']:.4f} +- {i['holdout_r2_se']:.4f}; {i['samples']} runs, "
+                 f"units, {i['best_holdout_r2']:.4f} +- {i['holdout_r2_se']:.4f}; {i['samples']} points, {int(counts.sum())} runs, "
                  f"{time.perf_counter() - t0:.1f} s)")
     (nets_dir / "nets.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if kk != "parity"}
                                                     for k, v in meta.items()}, indent=1))

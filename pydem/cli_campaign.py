@@ -2,6 +2,7 @@
 
     pydem campaign run data/campaigns/ring_shear_tiny.toml --store rs.h5   # new, or continue
     pydem campaign run --store rs.h5 --samples 512                         # extend, then run
+    pydem campaign run --store rs.h5 --replicates 2                        # every point once more
     pydem campaign run --store rs.h5 --dask tcp://scheduler:8786
     pydem campaign status rs.h5
     pydem campaign export rs.h5 --csv rs.csv
@@ -21,6 +22,7 @@ def add_parser(sub):
     run.add_argument("spec", nargs="?", help="campaign specification (TOML); not needed to continue a store")
     run.add_argument("--store", required=True, help="the campaign's HDF5 store")
     run.add_argument("--samples", type=int, help="samples of a new campaign (instead of the spec's), or grow a store to this many")
+    run.add_argument("--replicates", type=int, help="runs per design point (different seeds): new, or grow a store to this many")
     run.add_argument("--workers", type=int, help="local worker processes (default: cores / threads per run)")
     run.add_argument("--dask", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     run.add_argument("--retry-failed", action="store_true", help="run the failed samples again")
@@ -43,9 +45,10 @@ def main(args) -> int:
             Campaign.open(args.store).export_csv(args.csv)
             print(f"written {args.csv}")
         else:
-            target = args.samples
-            if target is not None and target < 1:
-                raise SpecError(f"--samples: expected a positive count, got {target}")
+            target, replicates = args.samples, args.replicates
+            for flag, value in (("--samples", target), ("--replicates", replicates)):
+                if value is not None and value < 1:
+                    raise SpecError(f"{flag}: expected a positive count, got {value}")
             if Path(args.store).exists():
                 c = Campaign.open(args.store)
                 if args.spec:
@@ -54,14 +57,16 @@ def main(args) -> int:
                         raise SpecError(f"{args.spec} differs from the specification stored in {args.store}; "
                                         "use a new store for a new campaign")
                     target = target or spec.samples
+                    replicates = replicates or spec.replicates
             elif args.spec:
                 spec = CampaignSpec.from_toml(args.spec)
-                spec.samples = args.samples or spec.samples  # --samples overrides the spec's count
+                spec.samples = args.samples or spec.samples  # --samples / --replicates override the spec's counts
+                spec.replicates = args.replicates or spec.replicates
                 c = Campaign.create(args.store, spec)
             else:
                 raise SpecError(f"{args.store} does not exist: give a campaign spec (TOML) to create it")
-            if target:
-                c.grow(target)
+            if target or replicates:
+                c.grow(target, replicates)
             counts = c.run(workers=args.workers, dask=args.dask, retry_failed=args.retry_failed,
                            max_runs=args.max_runs, quiet=args.quiet)
             print(f"campaign {args.store}: done {counts['done']}, failed {counts['failed']}, pending {counts['pending']}")
@@ -75,7 +80,8 @@ def main(args) -> int:
 
 
 def _same_campaign(a, b) -> bool:
-    """Same campaign whatever the sample count (a spec may ask for more samples: the store grows)."""
+    """Same campaign whatever the sample and replicate counts (a spec may ask for more: the store grows)."""
     da, db = dataclasses.asdict(a), dataclasses.asdict(b)
-    da.pop("samples"), db.pop("samples")
+    for key in ("samples", "replicates"):
+        da.pop(key), db.pop(key)
     return json.loads(json.dumps(da)) == json.loads(json.dumps(db))

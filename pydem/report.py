@@ -114,12 +114,16 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
           ("the smallest size within one standard error of the best hold-out R² (the curve is flat within its noise; "
            "small nets screen faster)" if summary.get("selection") == "one-se"
            else "the size with the best hold-out R²") + ".", "",
-          "| net | runs | hidden | hold-out R² | train R² | hold-out RMSE | best size: hidden, R² ± SE |",
-          "|---|---|---|---|---|---|---|"]
+          "Where design points were run more than once (different seeds), the nets fit the replicate means; "
+          "the noise ceiling is the R² a perfect net would reach on those means (1 − pooled replicate variance "
+          "/ replicates / variance of the means).", "",
+          "| net | points (runs) | hidden | hold-out R² | train R² | hold-out RMSE | best size: hidden, R² ± SE | noise ceiling |",
+          "|---|---|---|---|---|---|---|---|"]
     for k, m in trained["meta"].items():
-        L.append(f"| {k} | {m['samples']} | {m['hidden']} | {m['holdout_r2']:.4f} | {m['train_r2']:.4f} | "
+        ceiling = m.get("r2_noise_ceiling", float("nan"))
+        L.append(f"| {k} | {m['samples']} ({m.get('runs', m['samples'])}) | {m['hidden']} | {m['holdout_r2']:.4f} | {m['train_r2']:.4f} | "
                  f"{m['holdout_rmse']:.4g} {m['unit']} | {m['best_hidden']}, {m['best_holdout_r2']:.4f} ± "
-                 f"{m['holdout_r2_se']:.4f} |")
+                 f"{m['holdout_r2_se']:.4f} | {'—' if ceiling != ceiling else f'{ceiling:.3f}'} |")
     low = [k for k, m in trained["meta"].items() if m["holdout_r2"] < 0.95]
     if low:
         L += ["", f"**Below the R² ≥ 0.95 target:** {', '.join(low)} — the run-to-run scatter of these small test-scale "

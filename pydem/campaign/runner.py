@@ -105,7 +105,7 @@ class Campaign:
                               and key.split(".")[-1] not in spec.ranges}
         store = CampaignStore(path, spec, prov)
         c = cls(store)
-        c.grow(spec.samples)
+        c.grow(spec.samples, spec.replicates)
         store.save()
         return c
 
@@ -113,16 +113,31 @@ class Campaign:
     def open(cls, path: str | Path) -> "Campaign":
         return cls(CampaignStore.open(path))
 
-    def grow(self, total: int):
-        """Extends the design to `total` samples (existing samples and results unchanged)."""
+    def grow(self, total: int | None = None, replicates: int | None = None):
+        """Extends the design to `total` design points and/or runs every point `replicates` times
+        (existing runs and results unchanged). New rows run replicate by replicate, so a partly
+        run extension is a complete design with fewer replicates."""
         s, spec = self.store, self.store.spec
-        n0 = len(s)
-        if total <= n0:
-            return
-        batches = s.batches + [total - n0]
-        pts = design_points(spec.design, spec.ranges, n0, total, spec.seed, batches, spec.log_scale)
-        s.append(pts, np.array([sample_seed(spec.seed, i) for i in range(n0, total)]))
-        spec.samples = total
+        n0 = s.design_points
+        if total is not None and total > n0:
+            batches = s.batches + [total - n0]
+            pts = design_points(spec.design, spec.ranges, n0, total, spec.seed, batches, spec.log_scale)
+            s.append(pts, self._seeds(total - n0))
+            spec.samples = total
+        want = max(replicates or 1, spec.replicates)
+        have = s.replicates_of()
+        first = np.unique(s.points, return_index=True)[1]
+        for r in range(1, want):
+            short = np.flatnonzero(have <= r)
+            if len(short):
+                s.append(s.params[first[short]], self._seeds(len(short)), points=short)
+                have[short] += 1
+        spec.replicates = want
+
+    def _seeds(self, n: int) -> np.ndarray:
+        """Seeds of the next n rows: one per run, so replicates differ."""
+        start = len(self.store)
+        return np.array([sample_seed(self.store.spec.seed, i) for i in range(start, start + n)])
 
     def run(self, workers: int | None = None, dask: str | None = None, retry_failed: bool = False,
             max_runs: int | None = None, quiet: bool = False) -> dict[str, int]:
@@ -209,7 +224,8 @@ class Campaign:
         c = s.counts()
         spec = s.spec
         lines = [f"campaign {s.path}: rig {spec.rig} (preset {spec.preset}), design {spec.design} seed {spec.seed}",
-                 f"  samples {len(s)}: done {c['done']}, failed {c['failed']}, pending {c['pending']}"]
+                 f"  design points {s.design_points} x {spec.replicates} replicate(s) = {len(s)} runs: done {c['done']}, "
+                 f"failed {c['failed']}, pending {c['pending']}"]
         done = s.status == DONE
         if done.any():
             w = s.wall[done]
@@ -232,9 +248,9 @@ class Campaign:
         import csv
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["index", "seed", "status"] + s.spec.names + s.metric_names
+            w.writerow(["index", "point", "seed", "status"] + s.spec.names + s.metric_names
                        + [m + "_uncertainty" for m in s.metric_names] + ["wall_seconds", "error"])
             for i in range(len(s)):
-                w.writerow([i, int(s.seeds[i]), STATUS_NAMES[int(s.status[i])]]
+                w.writerow([i, int(s.points[i]), int(s.seeds[i]), STATUS_NAMES[int(s.status[i])]]
                            + [repr(float(x)) for x in s.params[i]] + [repr(float(x)) for x in s.values[i]]
                            + [repr(float(x)) for x in s.uncertainty[i]] + [repr(float(s.wall[i])), s.errors[i]])

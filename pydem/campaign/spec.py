@@ -5,7 +5,8 @@ parameters under study + a seeded space-filling design. Written as TOML by users
     preset = "tiny"
     design = "sobol"            # or "lhs"
     seed = 1
-    samples = 256
+    samples = 256               # design points
+    replicates = 1              # runs per design point (different seeds); nets fit the means
     [set]                       # fixed keys, as `pydem rig --set` takes them
     num_threads = 1
     "effects.cohesion_sjkr.energy_density" = 2e4
@@ -37,6 +38,7 @@ class CampaignSpec:
     design: str = "sobol"
     seed: int = 0
     samples: int = 64
+    replicates: int = 1
     log_scale: tuple[str, ...] = ()
 
     def __post_init__(self):
@@ -51,6 +53,8 @@ class CampaignSpec:
             raise SpecError(f"design: {self.design!r} is not sobol or lhs")
         if not isinstance(self.samples, int) or self.samples < 1:
             raise SpecError(f"samples: expected a positive integer, got {self.samples!r}")
+        if not isinstance(self.replicates, int) or self.replicates < 1:
+            raise SpecError(f"replicates: expected a positive integer, got {self.replicates!r}")
         if not self.ranges:
             raise SpecError("ranges: at least one parameter range is needed")
         for k, (lo, hi) in self.ranges.items():
@@ -92,7 +96,7 @@ class CampaignSpec:
             data = tomllib.loads(Path(path).read_text())
         except (OSError, tomllib.TOMLDecodeError) as exc:
             raise SpecError(f"cannot read campaign spec {path}: {exc}") from None
-        known = {"rig", "preset", "design", "seed", "samples", "set", "ranges", "log_scale"}
+        known = {"rig", "preset", "design", "seed", "samples", "replicates", "set", "ranges", "log_scale"}
         unknown = set(data) - known
         if unknown:
             raise SpecError(f"{path}: unknown keys {sorted(unknown)} (known: {sorted(known)})")
@@ -103,5 +107,6 @@ class CampaignSpec:
             if not (isinstance(v, list) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)):
                 raise SpecError(f"{path}: ranges.{k} must be [low, high], got {v!r}")
         return cls(rig=data["rig"], preset=data.get("preset", "default"), design=data.get("design", "sobol"),
-                   seed=int(data.get("seed", 0)), samples=data.get("samples", 64), fixed=dict(data.get("set", {})),
+                   seed=int(data.get("seed", 0)), samples=data.get("samples", 64),
+                   replicates=data.get("replicates", 1), fixed=dict(data.get("set", {})),
                    ranges={k: tuple(v) for k, v in ranges.items()}, log_scale=tuple(data.get("log_scale", ())))

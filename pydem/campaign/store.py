@@ -1,5 +1,7 @@
-"""The campaign store: one HDF5 file with the specification, the provenance, every sample's
-parameters, seed, status, metrics (value and uncertainty), wall time and failure message.
+"""The campaign store: one HDF5 file with the specification, the provenance, every run's
+design point, parameters, seed, status, metrics (value and uncertainty), wall time and failure
+message. A design point may be run several times with different seeds (replicates); rows are
+runs, `point` says which design point each row measures.
 
 Crash safety: the store is small (kilobytes per hundred runs), so every update writes a complete
 new file next to it, flushes it to disk and atomically renames it over the old one. A kill at any
@@ -18,7 +20,7 @@ import numpy as np
 from .spec import CampaignSpec
 
 FORMAT = "pydem-campaign"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: `point` per run (replicates); version 1 stores read as one run per point
 PENDING, DONE, FAILED = 0, 1, 2
 STATUS_NAMES = {PENDING: "pending", DONE: "done", FAILED: "failed"}
 
@@ -39,6 +41,7 @@ class CampaignStore:
         self.batches: list[int] = []
         self.params = np.zeros((0, len(spec.names)))
         self.seeds = np.zeros(0, dtype=np.int64)
+        self.points = np.zeros(0, dtype=np.int64)
         self.status = np.zeros(0, dtype=np.int8)
         self.wall = np.zeros(0)
         self.finished_at = np.zeros(0)
@@ -53,11 +56,24 @@ class CampaignStore:
     def __len__(self):
         return len(self.seeds)
 
-    def append(self, params: np.ndarray, seeds: np.ndarray):
+    @property
+    def design_points(self) -> int:
+        return int(self.points.max()) + 1 if len(self.points) else 0
+
+    def replicates_of(self) -> np.ndarray:
+        """Runs per design point (all statuses)."""
+        return np.bincount(self.points, minlength=self.design_points)
+
+    def append(self, params: np.ndarray, seeds: np.ndarray, points: np.ndarray | None = None):
+        """Appends runs; `points` None: each row a new design point (a design batch), else the
+        design points the rows replicate."""
         n = len(seeds)
-        self.batches.append(n)
+        if points is None:
+            points = self.design_points + np.arange(n)
+            self.batches.append(n)
         self.params = np.vstack([self.params, params])
         self.seeds = np.concatenate([self.seeds, np.asarray(seeds, dtype=np.int64)])
+        self.points = np.concatenate([self.points, np.asarray(points, dtype=np.int64)])
         self.status = np.concatenate([self.status, np.zeros(n, dtype=np.int8)])
         self.wall = np.concatenate([self.wall, np.full(n, np.nan)])
         self.finished_at = np.concatenate([self.finished_at, np.full(n, np.nan)])
@@ -104,6 +120,22 @@ class CampaignStore:
         ok = np.isfinite(self.values[:, j]) & ((self.status == DONE) if only_done else True)
         return self.params[ok], self.values[ok, j], self.uncertainty[ok, j]
 
+    def point_table(self, metric: str):
+        """One metric per design point: (inputs, mean over the point's finished replicates,
+        replicate count, pooled replicate standard deviation of one run (nan without replicates))."""
+        x_runs, y_runs, _ = self.table(metric)
+        j = self.metric_names.index(metric)
+        ok = np.isfinite(self.values[:, j]) & (self.status == DONE)
+        pts = self.points[ok]
+        uniq, inverse, counts = np.unique(pts, return_inverse=True, return_counts=True)
+        means = np.bincount(inverse, weights=y_runs) / counts
+        x = np.empty((len(uniq), x_runs.shape[1]))
+        x[inverse] = x_runs
+        dev2 = (y_runs - means[inverse]) ** 2
+        dof = int((counts - 1).sum())
+        pooled_sd = float(np.sqrt(dev2.sum() / dof)) if dof > 0 else float("nan")
+        return x, means, counts, pooled_sd
+
     # ---- file ------------------------------------------------------------------------
     def lock(self):
         """Exclusive writer lock; a second `campaign run` on the same store stops with an error."""
@@ -133,6 +165,7 @@ class CampaignStore:
             f.create_dataset("parameter_names", data=np.array(self.spec.names, dtype=object), dtype=h5py.string_dtype())
             f.create_dataset("parameters", data=self.params)
             f.create_dataset("seed", data=self.seeds)
+            f.create_dataset("point", data=self.points)
             f.create_dataset("status", data=self.status)
             f.create_dataset("wall_seconds", data=self.wall)
             f.create_dataset("finished_at", data=self.finished_at)
@@ -168,6 +201,8 @@ class CampaignStore:
                 s.batches = json.loads(f.attrs["batches"])
                 s.params = f["parameters"][()]
                 s.seeds, s.status = f["seed"][()], f["status"][()]
+                # stores from before replicates: one run per design point
+                s.points = f["point"][()] if "point" in f else np.arange(len(s.seeds), dtype=np.int64)
                 s.wall, s.finished_at = f["wall_seconds"][()], f["finished_at"][()]
                 s.errors = _strings(f["error"])
                 s.metric_names = _strings(f["metric_names"])
@@ -179,6 +214,6 @@ class CampaignStore:
             raise StoreError(f"{path}: unreadable campaign store ({type(exc).__name__}: {exc})") from None
         n = len(s.seeds)
         if not (s.params.shape == (n, len(s.spec.names)) and len(s.status) == n and s.values.shape[0] == n
-                and sum(s.batches) == n and len(s.errors) == n):
+                and len(s.points) == n and sum(s.batches) == s.design_points and len(s.errors) == n):
             raise StoreError(f"{path}: inconsistent campaign store (array lengths disagree)")
         return s

@@ -131,6 +131,36 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
         CampaignStore.open(tmp_path / "junk.h5")
 
 
+def test_replicates_grow_by_replicate_and_average_per_point(tmp_path):
+    with pytest.raises(SpecError, match="replicates: expected a positive integer"):
+        spec(replicates=0)
+    c = Campaign.create(tmp_path / "r.h5", spec(samples=3))
+    c.grow(replicates=2)
+    s = c.store
+    # replicate-major: a partly run extension is still a complete design
+    assert list(s.points) == [0, 1, 2, 0, 1, 2] and np.array_equal(s.params[3:], s.params[:3])
+    assert len(set(s.seeds.tolist())) == 6 and s.spec.replicates == 2
+    c.grow(5)  # new points get every replicate, existing rows never move
+    assert list(s.points) == [0, 1, 2, 0, 1, 2, 3, 4, 3, 4] and s.design_points == 5
+    assert np.array_equal(s.params[6:8], design_points("sobol", spec().ranges, 3, 5, 3, [3, 2]))
+    for i, v in enumerate([1.0, 2.0, 3.0, 2.0, 2.0, 5.0, 7.0, 9.0]):  # rows 8, 9 (point 3, 4 again) stay pending
+        s.record_done(i, {"m": (v, 0.0, "")}, 1.0)
+    s.save()
+    s = CampaignStore.open(tmp_path / "r.h5")
+    x, y, counts, sd = s.point_table("m")
+    assert np.array_equal(y, [1.5, 2.0, 4.0, 7.0, 9.0]) and list(counts) == [2, 2, 2, 1, 1]
+    assert np.array_equal(x, s.params[[0, 1, 2, 6, 7]])
+    # pooled sd of one run: deviations +-0.5, 0, +-1 over 3 degrees of freedom
+    assert sd == pytest.approx(np.sqrt((2 * 0.25 + 2 * 1.0) / 3), rel=1e-12)
+    # a store written before replicates (format 1, no `point`) reads as one run per point
+    import h5py
+    with h5py.File(tmp_path / "r.h5", "a") as f:
+        del f["point"]
+        f.attrs["format_version"] = 1
+        f.attrs["batches"] = json.dumps([10])
+    assert list(CampaignStore.open(tmp_path / "r.h5").points) == list(range(10))
+
+
 def test_dask_local_cluster(tmp_path):
     import distributed  # a real dependency (scripts/requirements.txt): never skipped
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
