@@ -12,6 +12,7 @@
  * order, then reactions in list order, then walls) does not depend on the thread count or on
  * deferral, so results are bitwise identical for any number of threads. */
 #include "contact_law.h"
+#include "pair_batch.h"
 #include "sweep.h"
 #include <float.h>
 #include <math.h>
@@ -27,75 +28,90 @@ typedef struct sweep_ctx {
     double lo[3], hi[3]; /* closed-axis bounds (+-DBL_MAX on periodic axes) */
 } sweep_ctx;
 
-/* Contacts of row i: forces on i summed into f/t (list order), reactions into the slots. */
-static inline void row_forces(const sweep_ctx *c, int64_t i, double *f, double *t, int64_t *bad_pair)
+/* Gathers the contacts among list entries [k0, k1) (the first in row `row`) into the batch;
+ * an entry whose spheres no longer touch forgets its springs and clears its slot once. */
+static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair_batch *b)
 {
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
     const double *x = d->x, *v = d->v, *w = d->w, *rad = d->radius, *im = d->inv_mass;
-    const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i], imi = im[i];
-    const double *vi = v + 3 * i, *wi = w + 3 * i;
-    const pair_props *row_pairs = d->pairs + (size_t)d->mat[i] * d->n_materials;
-    const double ratio = d->def.max_overlap_ratio;
-    double f0 = 0, f1 = 0, f2 = 0, t0 = 0, t1 = 0, t2 = 0;
-    const int64_t k1 = pl->start[i + 1];
-    for (int64_t k = pl->start[i]; k < k1; k++) {
-        const int32_t j = pl->j[k];
-        const double *sh = c->shift[pl->image[k]];
-        const double dx = xi0 - (x[3 * j] + sh[0]), dy = xi1 - (x[3 * j + 1] + sh[1]), dz = xi2 - (x[3 * j + 2] + sh[2]);
-        const double rj = rad[j], rsum = ri + rj;
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        if (r2 >= rsum * rsum) {
-            if (pl->active[k]) { /* contact ended: forget the springs, clear the slot once */
-                for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = d->slot[6 * k + a] = 0.0;
-                pl->active[k] = 0;
+    int m = 0, any_scalar = 0;
+    for (int64_t i = row; k0 < k1; i++) {
+        const int64_t e1 = pl->start[i + 1] < k1 ? pl->start[i + 1] : k1;
+        if (k0 >= e1) continue;
+        const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i], imi = im[i];
+        const double *vi = v + 3 * i, *wi = w + 3 * i;
+        const pair_props *row_pairs = d->pairs + (size_t)d->mat[i] * d->n_materials;
+        for (int64_t k = k0; k < e1; k++) {
+            const int32_t j = pl->j[k];
+            const double *sh = c->shift[pl->image[k]];
+            const double dx = xi0 - (x[3 * j] + sh[0]), dy = xi1 - (x[3 * j + 1] + sh[1]), dz = xi2 - (x[3 * j + 2] + sh[2]);
+            const double rj = rad[j], rsum = ri + rj;
+            const double r2 = dx * dx + dy * dy + dz * dz;
+            if (r2 >= rsum * rsum) {
+                if (pl->active[k]) {
+                    for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = d->slot[6 * k + a] = 0.0;
+                    pl->active[k] = 0;
+                }
+                continue;
             }
-            continue;
+            const pair_props *pp = &row_pairs[d->mat[j]];
+            const double *vj = v + 3 * j, *wj = w + 3 * j, *h = pl->hist + 6 * k;
+            b->k[m] = k;
+            b->j[m] = j;
+            b->pp[m] = pp;
+            b->dx[m] = dx;
+            b->dy[m] = dy;
+            b->dz[m] = dz;
+            b->r2[m] = r2;
+            b->ri[m] = ri;
+            b->rj[m] = rj;
+            b->imi[m] = imi;
+            b->imj[m] = im[j];
+            for (int a = 0; a < 3; a++) {
+                b->dv[a][m] = vi[a] - vj[a];
+                b->wi[a][m] = wi[a];
+                b->wj[a][m] = wj[a];
+            }
+            for (int a = 0; a < 6; a++) b->h[a][m] = h[a];
+            b->e_star[m] = pp->e_star;
+            b->g_star[m] = pp->g_star;
+            b->damping[m] = pp->damping_factor;
+            b->st_ratio[m] = pp->st_over_sn_sqrt;
+            b->friction[m] = pp->def.friction;
+            const int epsd2 = pp->def.rolling_model == DEM_ROLLING_EPSD2;
+            b->rolling[m] = epsd2 ? pp->def.rolling_friction : 0.0;
+            b->scalar[m] = (uint8_t)(pp->n_effects > 0 || (!epsd2 && pp->def.rolling_friction > 0.0));
+            any_scalar |= b->scalar[m];
+            m++;
         }
-        const double r = sqrt(r2), inv_r = 1.0 / r;
-        contact_in in;
-        in.n[0] = dx * inv_r;
-        in.n[1] = dy * inv_r;
-        in.n[2] = dz * inv_r;
-        in.overlap = rsum - r;
-        in.distance = r;
-        if (in.overlap > ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
-        const double ci = ri - 0.5 * in.overlap, cj = rj - 0.5 * in.overlap; /* lever arms */
-        const double *vj = v + 3 * j, *wj = w + 3 * j;
-        const double sw0 = ci * wi[0] + cj * wj[0], sw1 = ci * wi[1] + cj * wj[1], sw2 = ci * wi[2] + cj * wj[2];
-        in.vc[0] = vi[0] - vj[0] - (sw1 * in.n[2] - sw2 * in.n[1]);
-        in.vc[1] = vi[1] - vj[1] - (sw2 * in.n[0] - sw0 * in.n[2]);
-        in.vc[2] = vi[2] - vj[2] - (sw0 * in.n[1] - sw1 * in.n[0]);
-        in.wrel[0] = wi[0] - wj[0];
-        in.wrel[1] = wi[1] - wj[1];
-        in.wrel[2] = wi[2] - wj[2];
-        in.r_eff = ri * rj / rsum;
-        in.m_eff = 1.0 / (imi + im[j]);
-        in.radius_i = ri;
-        in.radius_j = rj;
-        in.inv_mass_i = imi;
-        in.inv_mass_j = im[j];
-        double *h = pl->hist + 6 * k, *sl = d->slot + 6 * k;
-        contact_out o;
-        contact_law(&row_pairs[d->mat[j]], &in, c->dt_hist, h, h + 3, &o);
-        for (int a = 0; a < 3; a++) {
-            sl[a] = o.force[a];
-            sl[3 + a] = -cj * o.cross[a] - o.mr[a];
-        }
-        pl->active[k] = 1;
-        f0 += o.force[0];
-        f1 += o.force[1];
-        f2 += o.force[2];
-        t0 += -ci * o.cross[0] + o.mr[0];
-        t1 += -ci * o.cross[1] + o.mr[1];
-        t2 += -ci * o.cross[2] + o.mr[2];
+        k0 = e1;
     }
-    f[0] = f0;
-    f[1] = f1;
-    f[2] = f2;
-    t[0] = t0;
-    t[1] = t1;
-    t[2] = t2;
+    b->m = m;
+    b->any_scalar = any_scalar;
+}
+
+/* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
+ * torque on i added to the row sums acc (force 3, torque 3). */
+static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair)
+{
+    dem_domain *d = c->d;
+    pair_list *pl = &d->pairs_cur;
+    const int64_t k = b->k[q];
+    const double ci = b->ci[q], cj = b->cj[q];
+    const double ri = b->ri[q], rj = b->rj[q];
+    if (b->overlap[q] > d->def.max_overlap_ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
+    double *h = pl->hist + 6 * k, *sl = d->slot + 6 * k;
+    for (int a = 0; a < 6; a++) h[a] = b->h[a][q];
+    for (int a = 0; a < 3; a++) {
+        sl[a] = b->force[a][q];
+        sl[3 + a] = -cj * b->cross[a][q] - b->mr[a][q];
+    }
+    pl->active[k] = 1;
+    for (int a = 0; a < 3; a++) {
+        acc[a] += b->force[a][q];
+        acc[3 + a] += -ci * b->cross[a][q] + b->mr[a][q];
+    }
 }
 
 /* Finish particle p: add the reactions (list order) and walls to its row sums, store the
@@ -200,19 +216,37 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t r0 = n * tid / nth, r1 = n * (tid + 1) / nth;
         sweep_result res;
         dem_sweep_result_init(&res);
-        for (int64_t i = r0; i < r1; i++) {
-            double f[3], t[3];
-            row_forces(&c, i, f, t, &res.bad_pair);
-            /* named only by rows of this thread up to i: finish now; else park the row sums
-             * in the force arrays and finish after the barrier */
-            if (d->trans_lo[i] >= r0 && d->trans_hi[i] <= i) {
-                finish(&c, i, f, t, &res);
-            } else {
-                for (int a = 0; a < 3; a++) {
-                    d->f[3 * i + a] = f[a];
-                    d->t[3 * i + a] = t[a];
+        pair_batch b; /* ~55 KB on the thread's stack */
+        pair_list *pl = &d->pairs_cur;
+        const int64_t kend = pl->start[r1];
+        int64_t row = r0, k = pl->start[r0];
+        double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
+        while (row < r1) {
+            const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
+            gather(&c, row, k, k1, &b);
+            dem_pair_batch_law(&b, dt_hist);
+            if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, pl->hist);
+            /* in list order; each row whose entries are all done is finished (or parked) */
+            int q = 0;
+            for (;;) {
+                const int64_t row_end = pl->start[row + 1];
+                for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair);
+                if (row_end > k1) break; /* the row goes on in the next batch */
+                double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
+                /* named only by rows of this thread up to this one: finish now; else park the
+                 * row sums in the force arrays and finish after the barrier */
+                if (d->trans_lo[row] >= r0 && d->trans_hi[row] <= row) {
+                    finish(&c, row, f, t, &res);
+                } else {
+                    for (int a = 0; a < 3; a++) {
+                        d->f[3 * row + a] = f[a];
+                        d->t[3 * row + a] = t[a];
+                    }
                 }
+                for (int a = 0; a < 6; a++) acc[a] = 0.0;
+                if (++row >= r1) break;
             }
+            k = k1;
         }
 #pragma omp barrier
         for (int64_t i = r0; i < r1; i++) {

@@ -1,0 +1,171 @@
+/* The batched pair contact law (see pair_batch.h): the operations of the pair geometry in
+ * sweep.c and of contact_law() in contact_law.h, in their order, written branch-free so the
+ * loop vectorises. Keep the three in step: tests/c/test_batch.c compares this loop with
+ * contact_law() bit for bit. */
+#include "pair_batch.h"
+#include "contact_law.h"
+#include <float.h>
+#include <math.h>
+
+void dem_pair_batch_law(pair_batch *b, double dt)
+{
+    const int m = b->m;
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC ivdep
+#endif
+    for (int q = 0; q < m; q++) {
+        /* geometry: unit normal from j to i, overlap, lever arms, contact-point velocity */
+        const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
+        const double n0 = b->dx[q] * inv_r, n1 = b->dy[q] * inv_r, n2 = b->dz[q] * inv_r;
+        const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
+        const double delta = rsum - r;
+        const double ci = ri - 0.5 * delta, cj = rj - 0.5 * delta;
+        const double wi0 = b->wi[0][q], wi1 = b->wi[1][q], wi2 = b->wi[2][q];
+        const double wj0 = b->wj[0][q], wj1 = b->wj[1][q], wj2 = b->wj[2][q];
+        const double sw0 = ci * wi0 + cj * wj0, sw1 = ci * wi1 + cj * wj1, sw2 = ci * wi2 + cj * wj2;
+        const double vc0 = b->dv[0][q] - (sw1 * n2 - sw2 * n1);
+        const double vc1 = b->dv[1][q] - (sw2 * n0 - sw0 * n2);
+        const double vc2 = b->dv[2][q] - (sw0 * n1 - sw1 * n0);
+        const double r_eff = ri * rj / rsum;
+        const double m_eff = 1.0 / (b->imi[q] + b->imj[q]);
+
+        /* normal: Hertz spring + restitution damper, no attraction */
+        const double sqrt_rd = sqrt(r_eff * delta);
+        const double sn = 2.0 * b->e_star[q] * sqrt_rd;
+        const double kn = (2.0 / 3.0) * sn;
+        const double kt = 8.0 * b->g_star[q] * sqrt_rd;
+        const double gn = b->damping[q] * sqrt(sn * m_eff);
+        const double gt = gn * b->st_ratio[q];
+        const double vn = vc0 * n0 + vc1 * n1 + vc2 * n2;
+        double fn = kn * delta - gn * vn;
+        fn = fn < 0.0 ? 0.0 : fn;
+
+        /* tangential: spring rotated into the tangent plane, Coulomb cap */
+        const double vt0 = vc0 - vn * n0, vt1 = vc1 - vn * n1, vt2 = vc2 - vn * n2;
+        double x0 = b->h[0][q], x1 = b->h[1][q], x2 = b->h[2][q];
+        {
+            const double h2 = x0 * x0 + x1 * x1 + x2 * x2;
+            const double hn = x0 * n0 + x1 * n1 + x2 * n2;
+            x0 -= hn * n0;
+            x1 -= hn * n1;
+            x2 -= hn * n2;
+            const double p2 = x0 * x0 + x1 * x1 + x2 * x2;
+            const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
+            x0 *= s;
+            x1 *= s;
+            x2 *= s;
+        }
+        x0 += vt0 * dt;
+        x1 += vt1 * dt;
+        x2 += vt2 * dt;
+        double ft0 = -kt * x0 - gt * vt0, ft1 = -kt * x1 - gt * vt1, ft2 = -kt * x2 - gt * vt2;
+        const double ft_sq = ft0 * ft0 + ft1 * ft1 + ft2 * ft2;
+        const double ftmax = b->friction[q] * fn;
+        const int slide = ft_sq > ftmax * ftmax;
+        const double cap = ftmax / sqrt(ft_sq);
+        const double fc0 = ft0 * cap, fc1 = ft1 * cap, fc2 = ft2 * cap;
+        const double ik = -1.0 / kt;
+        const int reset = slide & (kt > 0.0);
+        x0 = reset ? (fc0 + gt * vt0) * ik : x0;
+        x1 = reset ? (fc1 + gt * vt1) * ik : x1;
+        x2 = reset ? (fc2 + gt * vt2) * ik : x2;
+        ft0 = slide ? fc0 : ft0;
+        ft1 = slide ? fc1 : ft1;
+        ft2 = slide ? fc2 : ft2;
+        b->h[0][q] = x0;
+        b->h[1][q] = x1;
+        b->h[2][q] = x2;
+
+        /* rolling resistance, EPSD2: elastic-plastic spring kr = kt R*^2, limit mu_r R* F_n */
+        const double mu_r = b->rolling[q];
+        const double wr0 = wi0 - wj0, wr1 = wi1 - wj1, wr2 = wi2 - wj2;
+        const double wn = wr0 * n0 + wr1 * n1 + wr2 * n2;
+        const double u0 = wr0 - wn * n0, u1 = wr1 - wn * n1, u2 = wr2 - wn * n2;
+        const double mmax = mu_r * r_eff * fn;
+        const double kr = kt * r_eff * r_eff;
+        const double y0_in = b->h[3][q], y1_in = b->h[4][q], y2_in = b->h[5][q];
+        double y0 = y0_in, y1 = y1_in, y2 = y2_in;
+        {
+            const double h2 = y0 * y0 + y1 * y1 + y2 * y2;
+            const double hn = y0 * n0 + y1 * n1 + y2 * n2;
+            y0 -= hn * n0;
+            y1 -= hn * n1;
+            y2 -= hn * n2;
+            const double p2 = y0 * y0 + y1 * y1 + y2 * y2;
+            const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
+            y0 *= s;
+            y1 *= s;
+            y2 *= s;
+        }
+        y0 -= kr * u0 * dt;
+        y1 -= kr * u1 * dt;
+        y2 -= kr * u2 * dt;
+        const double m2 = y0 * y0 + y1 * y1 + y2 * y2;
+        const double mcap = mmax / sqrt(m2);
+        const int limit = m2 > mmax * mmax;
+        y0 = limit ? y0 * mcap : y0;
+        y1 = limit ? y1 * mcap : y1;
+        y2 = limit ? y2 * mcap : y2;
+        const int rolls = mu_r > 0.0;
+        b->h[3][q] = rolls ? y0 : y0_in;
+        b->h[4][q] = rolls ? y1 : y1_in;
+        b->h[5][q] = rolls ? y2 : y2_in;
+        b->mr[0][q] = rolls ? y0 : 0.0;
+        b->mr[1][q] = rolls ? y1 : 0.0;
+        b->mr[2][q] = rolls ? y2 : 0.0;
+
+        b->n[0][q] = n0;
+        b->n[1][q] = n1;
+        b->n[2][q] = n2;
+        b->overlap[q] = delta;
+        b->ci[q] = ci;
+        b->cj[q] = cj;
+        b->force[0][q] = fn * n0 + ft0;
+        b->force[1][q] = fn * n1 + ft1;
+        b->force[2][q] = fn * n2 + ft2;
+        b->cross[0][q] = n1 * ft2 - n2 * ft1;
+        b->cross[1][q] = n2 * ft0 - n0 * ft2;
+        b->cross[2][q] = n0 * ft1 - n1 * ft0;
+    }
+}
+
+void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist)
+{
+    for (int q = 0; q < b->m; q++) {
+        if (!b->scalar[q]) continue;
+        const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
+        const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
+        contact_in in;
+        in.n[0] = b->dx[q] * inv_r;
+        in.n[1] = b->dy[q] * inv_r;
+        in.n[2] = b->dz[q] * inv_r;
+        in.overlap = rsum - r;
+        in.distance = r;
+        const double ci = ri - 0.5 * in.overlap, cj = rj - 0.5 * in.overlap;
+        double sw[3], hist[6];
+        for (int a = 0; a < 3; a++) sw[a] = ci * b->wi[a][q] + cj * b->wj[a][q];
+        in.vc[0] = b->dv[0][q] - (sw[1] * in.n[2] - sw[2] * in.n[1]);
+        in.vc[1] = b->dv[1][q] - (sw[2] * in.n[0] - sw[0] * in.n[2]);
+        in.vc[2] = b->dv[2][q] - (sw[0] * in.n[1] - sw[1] * in.n[0]);
+        for (int a = 0; a < 3; a++) in.wrel[a] = b->wi[a][q] - b->wj[a][q];
+        in.r_eff = ri * rj / rsum;
+        in.m_eff = 1.0 / (b->imi[q] + b->imj[q]);
+        in.radius_i = ri;
+        in.radius_j = rj;
+        in.inv_mass_i = b->imi[q];
+        in.inv_mass_j = b->imj[q];
+        for (int a = 0; a < 6; a++) hist[a] = list_hist[6 * b->k[q] + a]; /* the batch loop moved b->h */
+        contact_out o;
+        contact_law(b->pp[q], &in, dt, hist, hist + 3, &o);
+        for (int a = 0; a < 6; a++) b->h[a][q] = hist[a];
+        for (int a = 0; a < 3; a++) {
+            b->n[a][q] = in.n[a];
+            b->force[a][q] = o.force[a];
+            b->cross[a][q] = o.cross[a];
+            b->mr[a][q] = o.mr[a];
+        }
+        b->overlap[q] = in.overlap;
+        b->ci[q] = ci;
+        b->cj[q] = cj;
+    }
+}
