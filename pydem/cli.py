@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     sub = ap.add_subparsers(dest="command", required=True)
     rig = sub.add_parser("rig", help="run a lab-test rig")
     rig.add_argument("name", choices=sorted(RIGS), help="which rig")
-    rig.add_argument("--preset", default="default", choices=("tiny", "default", "paper"), help="size preset")
+    rig.add_argument("--preset", default="default", help="size preset: tiny, default, paper (ring shear also: cell)")
     rig.add_argument("--config", help="TOML file with keys (and [params], [effects.<name>] tables)")
     rig.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override one key (repeatable)")
     rig.add_argument("--seed", type=int, default=0)

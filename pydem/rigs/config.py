@@ -123,17 +123,24 @@ def validate(cfg):
                 check_field(obj, f)
 
 
+def _preset(cls, name):
+    try:
+        return cls.preset(name)
+    except ValueError as exc:  # an unknown preset: the rig's message lists the known ones
+        raise ConfigError(str(exc)) from None
+
+
 def load(cls, preset: str = "default", path: str | Path | None = None, overrides: list[str] | None = None):
     """A rig config: the preset, then the TOML file's keys (top level and [params],
     [effects.<name>] tables), then `key=value` overrides; validated."""
-    cfg = cls.preset(preset)
+    cfg = _preset(cls, preset)
     if path is not None:
         try:
             data = tomllib.loads(Path(path).read_text())
         except (OSError, tomllib.TOMLDecodeError) as exc:
             raise ConfigError(f"cannot read config {path}: {exc}") from None
         if "preset" in data:
-            cfg = cls.preset(data.pop("preset"))
+            cfg = _preset(cls, data.pop("preset"))
         for key, value in data.items():
             if key in ("params", "effects") and isinstance(value, dict):
                 for k2, v2 in value.items():

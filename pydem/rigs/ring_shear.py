@@ -56,12 +56,20 @@ class RingShearConfig:
             return cls(particles=1200, diameter=3e-3, inner_radius=0.02, outer_radius=0.036, bars=8, bar_height=1.5e-3,
                        shear_points=[0.5], preshear_displacement=4e-3, first_preshear_displacement=6e-3,
                        max_preshear=8e-3, shear_displacement=3e-3, shear_speed=0.05)
+        if name == "cell":  # ~2 minutes on one core: the smallest cell found that feels mu_s (campaigns)
+            # 8 d wide, ~7 d deep, bars of 1 d: in the tiny cell the shear localises under the lid
+            # and mu_ie-ps even falls with mu_s; here it rises (0.536 -> 0.594 for mu_s 0.2 -> 0.8 at
+            # mu_r 0.1, seed sd 0.017; bench/results/ring_shear_design.txt). Pre-shear 20 mm, then
+            # 10 mm before the shear point: tau_pre averages 15 mm of steady flow.
+            return cls(particles=4300, diameter=3e-3, inner_radius=0.02, outer_radius=0.044, bars=12, bar_height=3e-3,
+                       shear_points=[0.5], preshear_displacement=1e-2, first_preshear_displacement=2e-2,
+                       max_preshear=3e-2, shear_displacement=3e-3, shear_speed=0.05)
         if name == "default":  # <= 3 minutes on 2 cores
             return cls()
         if name == "paper":  # a lab Schulze cell of 2 mm spheres (seed 000: silibeads)
             return cls(particles=60000, diameter=2e-3, inner_radius=0.05, outer_radius=0.1, bars=18,
                        bar_height=4e-3, shear_speed=0.01)
-        raise ValueError(f"unknown preset {name!r}: tiny, default or paper")
+        raise ValueError(f"unknown preset {name!r}: tiny, cell, default or paper")
 
 
 class RingShear:

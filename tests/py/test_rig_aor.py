@@ -68,6 +68,8 @@ def test_config_toml_and_errors(tmp_path):
         load(AorConfig, "tiny", overrides=["particles=many"])
     with pytest.raises(ConfigError, match="unknown effect"):
         load(AorConfig, "tiny", overrides=["effects.glue.strength=1"])
+    with pytest.raises(ConfigError, match="unknown preset 'cel': tiny, default or paper"):
+        load(AorConfig, "cel")
 
 
 def test_command_line(tmp_path):
