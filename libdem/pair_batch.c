@@ -7,6 +7,21 @@
 #include <float.h>
 #include <math.h>
 
+/* vec_project_keep_length() of contact_law.h on three scalars (so the loop stays vectorisable). */
+DEM_INLINE void keep_in_plane(double *x0, double *x1, double *x2, double n0, double n1, double n2)
+{
+    const double h2 = *x0 * *x0 + *x1 * *x1 + *x2 * *x2;
+    const double hn = *x0 * n0 + *x1 * n1 + *x2 * n2;
+    *x0 -= hn * n0;
+    *x1 -= hn * n1;
+    *x2 -= hn * n2;
+    const double p2 = *x0 * *x0 + *x1 * *x1 + *x2 * *x2;
+    const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
+    *x0 *= s;
+    *x1 *= s;
+    *x2 *= s;
+}
+
 void dem_pair_batch_law(pair_batch *b, double dt)
 {
     const int m = b->m;
@@ -43,18 +58,7 @@ void dem_pair_batch_law(pair_batch *b, double dt)
         /* tangential: spring rotated into the tangent plane, Coulomb cap */
         const double vt0 = vc0 - vn * n0, vt1 = vc1 - vn * n1, vt2 = vc2 - vn * n2;
         double x0 = b->h[0][q], x1 = b->h[1][q], x2 = b->h[2][q];
-        {
-            const double h2 = x0 * x0 + x1 * x1 + x2 * x2;
-            const double hn = x0 * n0 + x1 * n1 + x2 * n2;
-            x0 -= hn * n0;
-            x1 -= hn * n1;
-            x2 -= hn * n2;
-            const double p2 = x0 * x0 + x1 * x1 + x2 * x2;
-            const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
-            x0 *= s;
-            x1 *= s;
-            x2 *= s;
-        }
+        keep_in_plane(&x0, &x1, &x2, n0, n1, n2);
         x0 += vt0 * dt;
         x1 += vt1 * dt;
         x2 += vt2 * dt;
@@ -85,18 +89,7 @@ void dem_pair_batch_law(pair_batch *b, double dt)
         const double kr = kt * r_eff * r_eff;
         const double y0_in = b->h[3][q], y1_in = b->h[4][q], y2_in = b->h[5][q];
         double y0 = y0_in, y1 = y1_in, y2 = y2_in;
-        {
-            const double h2 = y0 * y0 + y1 * y1 + y2 * y2;
-            const double hn = y0 * n0 + y1 * n1 + y2 * n2;
-            y0 -= hn * n0;
-            y1 -= hn * n1;
-            y2 -= hn * n2;
-            const double p2 = y0 * y0 + y1 * y1 + y2 * y2;
-            const double s = sqrt(h2 / (p2 > DBL_MIN ? p2 : DBL_MIN));
-            y0 *= s;
-            y1 *= s;
-            y2 *= s;
-        }
+        keep_in_plane(&y0, &y1, &y2, n0, n1, n2);
         y0 -= kr * u0 * dt;
         y1 -= kr * u1 * dt;
         y2 -= kr * u2 * dt;
@@ -129,31 +122,38 @@ void dem_pair_batch_law(pair_batch *b, double dt)
     }
 }
 
+void dem_pair_batch_contact_in(const pair_batch *b, int q, contact_in *in, double *ci, double *cj)
+{
+    const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
+    const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
+    in->n[0] = b->dx[q] * inv_r;
+    in->n[1] = b->dy[q] * inv_r;
+    in->n[2] = b->dz[q] * inv_r;
+    in->overlap = rsum - r;
+    in->distance = r;
+    *ci = ri - 0.5 * in->overlap;
+    *cj = rj - 0.5 * in->overlap;
+    double sw[3];
+    for (int a = 0; a < 3; a++) sw[a] = *ci * b->wi[a][q] + *cj * b->wj[a][q];
+    in->vc[0] = b->dv[0][q] - (sw[1] * in->n[2] - sw[2] * in->n[1]);
+    in->vc[1] = b->dv[1][q] - (sw[2] * in->n[0] - sw[0] * in->n[2]);
+    in->vc[2] = b->dv[2][q] - (sw[0] * in->n[1] - sw[1] * in->n[0]);
+    for (int a = 0; a < 3; a++) in->wrel[a] = b->wi[a][q] - b->wj[a][q];
+    in->r_eff = ri * rj / rsum;
+    in->m_eff = 1.0 / (b->imi[q] + b->imj[q]);
+    in->radius_i = ri;
+    in->radius_j = rj;
+    in->inv_mass_i = b->imi[q];
+    in->inv_mass_j = b->imj[q];
+}
+
 void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist)
 {
     for (int q = 0; q < b->m; q++) {
         if (!b->scalar[q]) continue;
-        const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
-        const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
         contact_in in;
-        in.n[0] = b->dx[q] * inv_r;
-        in.n[1] = b->dy[q] * inv_r;
-        in.n[2] = b->dz[q] * inv_r;
-        in.overlap = rsum - r;
-        in.distance = r;
-        const double ci = ri - 0.5 * in.overlap, cj = rj - 0.5 * in.overlap;
-        double sw[3], hist[6];
-        for (int a = 0; a < 3; a++) sw[a] = ci * b->wi[a][q] + cj * b->wj[a][q];
-        in.vc[0] = b->dv[0][q] - (sw[1] * in.n[2] - sw[2] * in.n[1]);
-        in.vc[1] = b->dv[1][q] - (sw[2] * in.n[0] - sw[0] * in.n[2]);
-        in.vc[2] = b->dv[2][q] - (sw[0] * in.n[1] - sw[1] * in.n[0]);
-        for (int a = 0; a < 3; a++) in.wrel[a] = b->wi[a][q] - b->wj[a][q];
-        in.r_eff = ri * rj / rsum;
-        in.m_eff = 1.0 / (b->imi[q] + b->imj[q]);
-        in.radius_i = ri;
-        in.radius_j = rj;
-        in.inv_mass_i = b->imi[q];
-        in.inv_mass_j = b->imj[q];
+        double ci, cj, hist[6];
+        dem_pair_batch_contact_in(b, q, &in, &ci, &cj);
         for (int a = 0; a < 6; a++) hist[a] = list_hist[6 * b->k[q] + a]; /* the batch loop moved b->h */
         contact_out o;
         contact_law(b->pp[q], &in, dt, hist, hist + 3, &o);

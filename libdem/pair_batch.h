@@ -44,4 +44,9 @@ void dem_pair_batch_law(pair_batch *b, double dt);
  * in the pair list (list_hist: 6 per entry, not yet updated); results replace the batch's. */
 void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist);
 
+/* The scalar law's input for contact q (geometry and kinematics as the sweep defines them),
+ * with the lever arms ci, cj. */
+struct contact_in;
+void dem_pair_batch_contact_in(const pair_batch *b, int q, struct contact_in *in, double *ci, double *cj);
+
 #endif

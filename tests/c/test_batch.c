@@ -74,26 +74,9 @@ static void random_contact(pair_batch *b, int q, const pair_props *pp, double *h
 /* The scalar reference, as the engine computed pair contacts before batching. */
 static void reference(const pair_batch *b, int q, const double *h0, double dt, double *out)
 {
-    const double r = sqrt(b->r2[q]), inv_r = 1.0 / r, ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
     contact_in in;
-    in.n[0] = b->dx[q] * inv_r;
-    in.n[1] = b->dy[q] * inv_r;
-    in.n[2] = b->dz[q] * inv_r;
-    in.overlap = rsum - r;
-    in.distance = r;
-    const double ci = ri - 0.5 * in.overlap, cj = rj - 0.5 * in.overlap;
-    const double sw0 = ci * b->wi[0][q] + cj * b->wj[0][q], sw1 = ci * b->wi[1][q] + cj * b->wj[1][q],
-                 sw2 = ci * b->wi[2][q] + cj * b->wj[2][q];
-    in.vc[0] = b->dv[0][q] - (sw1 * in.n[2] - sw2 * in.n[1]);
-    in.vc[1] = b->dv[1][q] - (sw2 * in.n[0] - sw0 * in.n[2]);
-    in.vc[2] = b->dv[2][q] - (sw0 * in.n[1] - sw1 * in.n[0]);
-    for (int a = 0; a < 3; a++) in.wrel[a] = b->wi[a][q] - b->wj[a][q];
-    in.r_eff = ri * rj / rsum;
-    in.m_eff = 1.0 / (b->imi[q] + b->imj[q]);
-    in.radius_i = ri;
-    in.radius_j = rj;
-    in.inv_mass_i = b->imi[q];
-    in.inv_mass_j = b->imj[q];
+    double ci, cj;
+    dem_pair_batch_contact_in(b, q, &in, &ci, &cj);
     double h[6];
     memcpy(h, h0, sizeof h);
     contact_out o;
