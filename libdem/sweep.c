@@ -5,12 +5,15 @@
  * order (the forward half of the cell stencil), except across periodic faces. Processing rows
  * in order, particle p's forces are therefore complete once row p is done: its own row gives
  * the i-side, and every entry naming p as partner was in an earlier row, whose reaction waits
- * in a per-entry slot. p is then finished at once — reactions gathered, walls added, closing
- * half kick, opening half kick and drift — and nothing later reads its old state.
+ * in its per-particle reaction sum. p is then finished at once — reactions added, walls
+ * added, closing half kick, opening half kick and drift — and nothing later reads its old state.
  * A particle named by a later row (periodic wrap) or by another thread's rows is "deferred":
- * finished after all rows are done. The summation order of every force (own row in list
- * order, then reactions in list order, then walls) does not depend on the thread count or on
- * deferral, so results are bitwise identical for any number of threads. */
+ * finished after all rows are done. A particle named by another thread's rows ("shared") cannot
+ * have its reactions summed as they come (two threads would add); its reactions are read back
+ * from the per-entry slots instead, in list order. Either way every force is summed in the same
+ * order — reactions in list order from zero, subtracted from the own-row sum (list order), then
+ * walls — whatever the thread count or deferral, so results are bitwise identical for any
+ * number of threads. */
 #include "contact_law.h"
 #include "pair_batch.h"
 #include "sweep.h"
@@ -91,9 +94,17 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     b->any_scalar = any_scalar;
 }
 
+/* Whether rows outside [r0, r1) (another thread's) name particle p, or p is not in [r0, r1). */
+static inline int shared(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
+{
+    return p < r0 || p >= r1 || d->trans_lo[p] < r0 || d->trans_hi[p] >= r1;
+}
+
 /* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
- * torque on i added to the row sums acc (force 3, torque 3). */
-static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair)
+ * torque on i added to the row sums acc (force 3, torque 3), the reaction to the partner's sum
+ * unless the partner is shared. */
+static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair, int64_t r0,
+                           int64_t r1)
 {
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
@@ -112,22 +123,36 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
         acc[a] += b->force[a][q];
         acc[3 + a] += -ci * b->cross[a][q] + b->mr[a][q];
     }
+    const int32_t j = b->j[q];
+    if (!shared(d, j, r0, r1)) {
+        double *rj = d->reaction + 6 * (int64_t)j;
+        for (int a = 0; a < 6; a++) rj[a] += sl[a];
+    }
 }
 
-/* Finish particle p: add the reactions (list order) and walls to its row sums, store the
+/* Finish particle p: add its reactions (summed in list order: from its slots if it is shared,
+ * else as summed during the sweep, which it resets) and walls to its row sums, store the
  * forces, then the kicks and drift the mode asks for. */
-static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, sweep_result *res)
+static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, sweep_result *res, int is_shared)
 {
     dem_domain *d = c->d;
-    const int32_t *te = d->trans_entry;
-    for (int64_t q = d->trans_start[p]; q < d->trans_start[p + 1]; q++) {
-        const double *sl = d->slot + 6 * (int64_t)te[q];
-        f[0] -= sl[0];
-        f[1] -= sl[1];
-        f[2] -= sl[2];
-        t[0] += sl[3];
-        t[1] += sl[4];
-        t[2] += sl[5];
+    double r[6] = {0, 0, 0, 0, 0, 0};
+    if (is_shared) {
+        const int32_t *te = d->trans_entry;
+        for (int64_t q = d->trans_start[p]; q < d->trans_start[p + 1]; q++) {
+            const double *sl = d->slot + 6 * (int64_t)te[q];
+            for (int a = 0; a < 6; a++) r[a] += sl[a];
+        }
+    } else {
+        double *rp = d->reaction + 6 * p;
+        for (int a = 0; a < 6; a++) {
+            r[a] = rp[a];
+            rp[a] = 0.0;
+        }
+    }
+    for (int a = 0; a < 3; a++) {
+        f[a] -= r[a];
+        t[a] += r[3 + a];
     }
     if (d->walls_cur.start[p] < d->walls_cur.start[p + 1]) dem_wall_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
     if (d->tris_cur.start[p] < d->tris_cur.start[p + 1]) dem_mesh_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
@@ -230,13 +255,13 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
             int q = 0;
             for (;;) {
                 const int64_t row_end = pl->start[row + 1];
-                for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair);
+                for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair, r0, r1);
                 if (row_end > k1) break; /* the row goes on in the next batch */
                 double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
                 /* named only by rows of this thread up to this one: finish now; else park the
                  * row sums in the force arrays and finish after the barrier */
                 if (d->trans_lo[row] >= r0 && d->trans_hi[row] <= row) {
-                    finish(&c, row, f, t, &res);
+                    finish(&c, row, f, t, &res, 0);
                 } else {
                     for (int a = 0; a < 3; a++) {
                         d->f[3 * row + a] = f[a];
@@ -253,7 +278,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
             if (d->trans_lo[i] >= r0 && d->trans_hi[i] <= i) continue;
             double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
             double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
-            finish(&c, i, f, t, &res);
+            finish(&c, i, f, t, &res, shared(d, i, r0, r1));
         }
         maxdisp2 = res.maxdisp2;
         bad_nan = res.bad_nan;
