@@ -34,6 +34,15 @@ typedef struct contact_out {
     double mr[3];     /* rolling torque on i (partner gets -mr) */
 } contact_out;
 
+/* The torques a pair contact puts on i and on its partner j (lever arms ci, cj). */
+DEM_INLINE void contact_torques(const contact_out *o, double ci, double cj, double *ti, double *tj)
+{
+    for (int a = 0; a < 3; a++) {
+        ti[a] = -ci * o->cross[a] + o->mr[a];
+        tj[a] = -cj * o->cross[a] - o->mr[a];
+    }
+}
+
 DEM_INLINE void vec_project_keep_length(double *h, const double *n)
 {
     /* Rotate a history vector into the current tangent plane: project, restore length.

@@ -6,6 +6,7 @@
 #include "contact_law.h"
 #include <float.h>
 #include <math.h>
+#include <string.h>
 
 /* vec_project_keep_length() of contact_law.h on three scalars (so the loop stays vectorisable). */
 DEM_INLINE void keep_in_plane(double *x0, double *x1, double *x2, double n0, double n1, double n2)
@@ -22,7 +23,42 @@ DEM_INLINE void keep_in_plane(double *x0, double *x1, double *x2, double n0, dou
     *x2 *= s;
 }
 
-void dem_pair_batch_law(pair_batch *b, double dt)
+static int takes_scalar_law(const pair_props *pp)
+{
+    return pp->n_effects > 0 || (pp->def.rolling_model != DEM_ROLLING_EPSD2 && pp->def.rolling_friction > 0.0);
+}
+
+void dem_pair_batch_props(pair_batch *b)
+{
+    const int m = b->m;
+    int same = 1;
+    for (int q = 1; q < m; q++) same &= b->pp[q] == b->pp[0];
+    b->uniform = m > 0 && same ? b->pp[0] : NULL;
+    if (b->uniform) {
+        const uint8_t sc = (uint8_t)takes_scalar_law(b->uniform);
+        memset(b->scalar, sc, (size_t)m);
+        b->any_scalar = sc;
+        return;
+    }
+    int any = 0;
+    for (int q = 0; q < m; q++) {
+        const pair_props *pp = b->pp[q];
+        b->e_star[q] = pp->e_star;
+        b->g_star[q] = pp->g_star;
+        b->damping[q] = pp->damping_factor;
+        b->st_ratio[q] = pp->st_over_sn_sqrt;
+        b->friction[q] = pp->def.friction;
+        b->rolling[q] = pp->def.rolling_model == DEM_ROLLING_EPSD2 ? pp->def.rolling_friction : 0.0;
+        b->scalar[q] = (uint8_t)takes_scalar_law(pp);
+        any |= b->scalar[q];
+    }
+    b->any_scalar = any;
+}
+
+/* The loop, specialised (after inlining) for a uniform batch, whose constants are the u_*
+ * arguments, and for per-contact constants. */
+DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const double u_e_star, const double u_g_star,
+                         const double u_damping, const double u_st_ratio, const double u_friction, const double u_rolling)
 {
     const int m = b->m;
 #if defined(__GNUC__) && !defined(__clang__)
@@ -46,11 +82,11 @@ void dem_pair_batch_law(pair_batch *b, double dt)
 
         /* normal: Hertz spring + restitution damper, no attraction */
         const double sqrt_rd = sqrt(r_eff * delta);
-        const double sn = 2.0 * b->e_star[q] * sqrt_rd;
+        const double sn = 2.0 * (uniform ? u_e_star : b->e_star[q]) * sqrt_rd;
         const double kn = (2.0 / 3.0) * sn;
-        const double kt = 8.0 * b->g_star[q] * sqrt_rd;
-        const double gn = b->damping[q] * sqrt(sn * m_eff);
-        const double gt = gn * b->st_ratio[q];
+        const double kt = 8.0 * (uniform ? u_g_star : b->g_star[q]) * sqrt_rd;
+        const double gn = (uniform ? u_damping : b->damping[q]) * sqrt(sn * m_eff);
+        const double gt = gn * (uniform ? u_st_ratio : b->st_ratio[q]);
         const double vn = vc0 * n0 + vc1 * n1 + vc2 * n2;
         double fn = kn * delta - gn * vn;
         fn = fn < 0.0 ? 0.0 : fn;
@@ -64,7 +100,7 @@ void dem_pair_batch_law(pair_batch *b, double dt)
         x2 += vt2 * dt;
         double ft0 = -kt * x0 - gt * vt0, ft1 = -kt * x1 - gt * vt1, ft2 = -kt * x2 - gt * vt2;
         const double ft_sq = ft0 * ft0 + ft1 * ft1 + ft2 * ft2;
-        const double ftmax = b->friction[q] * fn;
+        const double ftmax = (uniform ? u_friction : b->friction[q]) * fn;
         const int slide = ft_sq > ftmax * ftmax;
         const double cap = ftmax / sqrt(ft_sq);
         const double fc0 = ft0 * cap, fc1 = ft1 * cap, fc2 = ft2 * cap;
@@ -81,7 +117,7 @@ void dem_pair_batch_law(pair_batch *b, double dt)
         b->h[2][q] = x2;
 
         /* rolling resistance, EPSD2: elastic-plastic spring kr = kt R*^2, limit mu_r R* F_n */
-        const double mu_r = b->rolling[q];
+        const double mu_r = uniform ? u_rolling : b->rolling[q];
         const double wr0 = wi0 - wj0, wr1 = wi1 - wj1, wr2 = wi2 - wj2;
         const double wn = wr0 * n0 + wr1 * n1 + wr2 * n2;
         const double u0 = wr0 - wn * n0, u1 = wr1 - wn * n1, u2 = wr2 - wn * n2;
@@ -103,23 +139,31 @@ void dem_pair_batch_law(pair_batch *b, double dt)
         b->h[3][q] = rolls ? y0 : y0_in;
         b->h[4][q] = rolls ? y1 : y1_in;
         b->h[5][q] = rolls ? y2 : y2_in;
-        b->mr[0][q] = rolls ? y0 : 0.0;
-        b->mr[1][q] = rolls ? y1 : 0.0;
-        b->mr[2][q] = rolls ? y2 : 0.0;
+        const double mr0 = rolls ? y0 : 0.0, mr1 = rolls ? y1 : 0.0, mr2 = rolls ? y2 : 0.0;
 
-        b->n[0][q] = n0;
-        b->n[1][q] = n1;
-        b->n[2][q] = n2;
+        /* force on i; torques on i and on j (contact_torques() of contact_law.h) */
+        const double cr0 = n1 * ft2 - n2 * ft1, cr1 = n2 * ft0 - n0 * ft2, cr2 = n0 * ft1 - n1 * ft0;
         b->overlap[q] = delta;
-        b->ci[q] = ci;
-        b->cj[q] = cj;
         b->force[0][q] = fn * n0 + ft0;
         b->force[1][q] = fn * n1 + ft1;
         b->force[2][q] = fn * n2 + ft2;
-        b->cross[0][q] = n1 * ft2 - n2 * ft1;
-        b->cross[1][q] = n2 * ft0 - n0 * ft2;
-        b->cross[2][q] = n0 * ft1 - n1 * ft0;
+        b->ti[0][q] = -ci * cr0 + mr0;
+        b->ti[1][q] = -ci * cr1 + mr1;
+        b->ti[2][q] = -ci * cr2 + mr2;
+        b->tj[0][q] = -cj * cr0 - mr0;
+        b->tj[1][q] = -cj * cr1 - mr1;
+        b->tj[2][q] = -cj * cr2 - mr2;
     }
+}
+
+void dem_pair_batch_law(pair_batch *b, double dt)
+{
+    const pair_props *u = b->uniform;
+    if (u)
+        law_loop(b, dt, 1, u->e_star, u->g_star, u->damping_factor, u->st_over_sn_sqrt, u->def.friction,
+                 u->def.rolling_model == DEM_ROLLING_EPSD2 ? u->def.rolling_friction : 0.0);
+    else
+        law_loop(b, dt, 0, 0, 0, 0, 0, 0, 0);
 }
 
 void dem_pair_batch_contact_in(const pair_batch *b, int q, contact_in *in, double *ci, double *cj)
@@ -158,14 +202,13 @@ void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist
         contact_out o;
         contact_law(b->pp[q], &in, dt, hist, hist + 3, &o);
         for (int a = 0; a < 6; a++) b->h[a][q] = hist[a];
+        double ti[3], tj[3];
+        contact_torques(&o, ci, cj, ti, tj);
         for (int a = 0; a < 3; a++) {
-            b->n[a][q] = in.n[a];
             b->force[a][q] = o.force[a];
-            b->cross[a][q] = o.cross[a];
-            b->mr[a][q] = o.mr[a];
+            b->ti[a][q] = ti[a];
+            b->tj[a][q] = tj[a];
         }
         b->overlap[q] = in.overlap;
-        b->ci[q] = ci;
-        b->cj[q] = cj;
     }
 }

@@ -20,6 +20,7 @@
 typedef struct pair_batch {
     int m;                              /* contacts in the batch */
     int any_scalar;
+    const pair_props *uniform;          /* every contact of this pair type: the constants below unset */
     /* gathered: list entry, partner, geometry and kinematics (i minus j) */
     int64_t k[DEM_PAIR_BATCH];
     int32_t j[DEM_PAIR_BATCH];
@@ -29,13 +30,16 @@ typedef struct pair_batch {
     double ri[DEM_PAIR_BATCH], rj[DEM_PAIR_BATCH], imi[DEM_PAIR_BATCH], imj[DEM_PAIR_BATCH];
     double dv[3][DEM_PAIR_BATCH], wi[3][DEM_PAIR_BATCH], wj[3][DEM_PAIR_BATCH];
     double h[6][DEM_PAIR_BATCH];        /* spring histories in (xi 3, rolling torque 3), updated in place */
-    /* pair constants */
+    /* pair constants, set by dem_pair_batch_props() unless the batch is uniform */
     double e_star[DEM_PAIR_BATCH], g_star[DEM_PAIR_BATCH], damping[DEM_PAIR_BATCH], st_ratio[DEM_PAIR_BATCH];
     double friction[DEM_PAIR_BATCH], rolling[DEM_PAIR_BATCH]; /* rolling: mu_r of EPSD2 pairs, else 0 */
-    /* results */
-    double n[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH], ci[DEM_PAIR_BATCH], cj[DEM_PAIR_BATCH];
-    double force[3][DEM_PAIR_BATCH], cross[3][DEM_PAIR_BATCH], mr[3][DEM_PAIR_BATCH];
+    /* results: force on i, torques on i and on j, overlap */
+    double force[3][DEM_PAIR_BATCH], ti[3][DEM_PAIR_BATCH], tj[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH];
 } pair_batch;
+
+/* After the gather (pp[] set): the scalar flags, and either `uniform` (one pair type, the
+ * common case: the law reads its constants once) or the per-contact constant arrays. */
+void dem_pair_batch_props(pair_batch *b);
 
 /* The contact law of every non-scalar contact of the batch (dt: spring history increment). */
 void dem_pair_batch_law(pair_batch *b, double dt);

@@ -38,7 +38,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
     const double *x = d->x, *v = d->v, *w = d->w, *rad = d->radius, *im = d->inv_mass;
-    int m = 0, any_scalar = 0;
+    int m = 0;
     for (int64_t i = row; k0 < k1; i++) {
         const int64_t e1 = pl->start[i + 1] < k1 ? pl->start[i + 1] : k1;
         if (k0 >= e1) continue;
@@ -58,11 +58,10 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
                 }
                 continue;
             }
-            const pair_props *pp = &row_pairs[d->mat[j]];
             const double *vj = v + 3 * j, *wj = w + 3 * j, *h = pl->hist + 6 * k;
             b->k[m] = k;
             b->j[m] = j;
-            b->pp[m] = pp;
+            b->pp[m] = &row_pairs[d->mat[j]];
             b->dx[m] = dx;
             b->dy[m] = dy;
             b->dz[m] = dz;
@@ -77,21 +76,12 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
                 b->wj[a][m] = wj[a];
             }
             for (int a = 0; a < 6; a++) b->h[a][m] = h[a];
-            b->e_star[m] = pp->e_star;
-            b->g_star[m] = pp->g_star;
-            b->damping[m] = pp->damping_factor;
-            b->st_ratio[m] = pp->st_over_sn_sqrt;
-            b->friction[m] = pp->def.friction;
-            const int epsd2 = pp->def.rolling_model == DEM_ROLLING_EPSD2;
-            b->rolling[m] = epsd2 ? pp->def.rolling_friction : 0.0;
-            b->scalar[m] = (uint8_t)(pp->n_effects > 0 || (!epsd2 && pp->def.rolling_friction > 0.0));
-            any_scalar |= b->scalar[m];
             m++;
         }
         k0 = e1;
     }
     b->m = m;
-    b->any_scalar = any_scalar;
+    dem_pair_batch_props(b);
 }
 
 /* Whether rows outside [r0, r1) (another thread's) name particle p, or p is not in [r0, r1). */
@@ -109,19 +99,18 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
     const int64_t k = b->k[q];
-    const double ci = b->ci[q], cj = b->cj[q];
     const double ri = b->ri[q], rj = b->rj[q];
     if (b->overlap[q] > d->def.max_overlap_ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
     double *h = pl->hist + 6 * k, *sl = d->slot + 6 * k;
     for (int a = 0; a < 6; a++) h[a] = b->h[a][q];
     for (int a = 0; a < 3; a++) {
         sl[a] = b->force[a][q];
-        sl[3 + a] = -cj * b->cross[a][q] - b->mr[a][q];
+        sl[3 + a] = b->tj[a][q];
     }
     pl->active[k] = 1;
     for (int a = 0; a < 3; a++) {
         acc[a] += b->force[a][q];
-        acc[3 + a] += -ci * b->cross[a][q] + b->mr[a][q];
+        acc[3 + a] += b->ti[a][q];
     }
     const int32_t j = b->j[q];
     if (!shared(d, j, r0, r1)) {

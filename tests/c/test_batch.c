@@ -1,7 +1,7 @@
 /* The batched pair law (libdem/pair_batch.c) against the scalar contact law (contact_law.h):
  * random contacts — fresh and loaded springs, sticking and sliding, rolling springs below and
- * at their limit, several pair types in one batch — must give bit-identical forces, torques,
- * normals, overlaps and updated histories. Tolerance zero: the batch loop is the same sequence
+ * at their limit, several pair types in one batch or one type (the uniform loop) — must give
+ * bit-identical forces, torques, overlaps and updated histories. Tolerance zero: the batch loop is the same sequence
  * of IEEE operations, and the engine's results (and the published benchmarks) rely on it.
  * Pairs the loop does not cover (CDT and EPSD rolling) go through contact_law() and must match
  * too. */
@@ -60,19 +60,13 @@ static void random_contact(pair_batch *b, int q, const pair_props *pp, double *h
         h0[3 + a] = fresh ? 0.0 : uniform(-1, 1) * (loaded ? 1e-3 : 1e-8);
     }
     for (int a = 0; a < 6; a++) b->h[a][q] = h0[a];
-    b->e_star[q] = pp->e_star;
-    b->g_star[q] = pp->g_star;
-    b->damping[q] = pp->damping_factor;
-    b->st_ratio[q] = pp->st_over_sn_sqrt;
-    b->friction[q] = pp->def.friction;
-    const int epsd2 = pp->def.rolling_model == DEM_ROLLING_EPSD2;
-    b->rolling[q] = epsd2 ? pp->def.rolling_friction : 0.0;
-    b->scalar[q] = (uint8_t)(!epsd2 && pp->def.rolling_friction > 0.0);
-    b->any_scalar |= b->scalar[q];
 }
 
-/* The scalar reference, as the engine computed pair contacts before batching. */
-static void reference(const pair_batch *b, int q, const double *h0, double dt, double *out)
+#define N_OUT 16 /* force 3, torque on i 3, torque on j 3, histories 6, overlap */
+
+/* The scalar reference, as the engine computed pair contacts before batching (and the normal,
+ * n, to classify the regime). */
+static void reference(const pair_batch *b, int q, const double *h0, double dt, double *out, double *n)
 {
     contact_in in;
     double ci, cj;
@@ -81,16 +75,13 @@ static void reference(const pair_batch *b, int q, const double *h0, double dt, d
     memcpy(h, h0, sizeof h);
     contact_out o;
     contact_law(b->pp[q], &in, dt, h, h + 3, &o);
+    contact_torques(&o, ci, cj, out + 3, out + 6);
     for (int a = 0; a < 3; a++) {
         out[a] = o.force[a];
-        out[3 + a] = o.cross[a];
-        out[6 + a] = o.mr[a];
-        out[9 + a] = in.n[a];
+        n[a] = in.n[a];
     }
-    memcpy(out + 12, h, sizeof h);
-    out[18] = in.overlap;
-    out[19] = ci;
-    out[20] = cj;
+    memcpy(out + 9, h, sizeof h);
+    out[15] = in.overlap;
 }
 
 static void check_batch(const pair_props *types, int n_types, int m, int *slides, int *limits)
@@ -104,31 +95,33 @@ static void check_batch(const pair_props *types, int n_types, int m, int *slides
         random_contact(&b, q, &types[q % n_types], h0[q]);
         memcpy(list_hist + 6 * b.k[q], h0[q], sizeof h0[q]);
     }
+    dem_pair_batch_props(&b);
+    assert_true((b.uniform != NULL) == (n_types == 1 || m == 1));
     dem_pair_batch_law(&b, dt);
     if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt, list_hist);
     for (int q = 0; q < m; q++) {
-        double want[21], got[21];
-        reference(&b, q, h0[q], dt, want);
+        double want[N_OUT], got[N_OUT], n[3];
+        reference(&b, q, h0[q], dt, want, n);
         for (int a = 0; a < 3; a++) {
             got[a] = b.force[a][q];
-            got[3 + a] = b.cross[a][q];
-            got[6 + a] = b.mr[a][q];
-            got[9 + a] = b.n[a][q];
+            got[3 + a] = b.ti[a][q];
+            got[6 + a] = b.tj[a][q];
         }
-        for (int a = 0; a < 6; a++) got[12 + a] = b.h[a][q];
-        got[18] = b.overlap[q];
-        got[19] = b.ci[q];
-        got[20] = b.cj[q];
-        for (int v = 0; v < 21; v++) {
+        for (int a = 0; a < 6; a++) got[9 + a] = b.h[a][q];
+        got[15] = b.overlap[q];
+        for (int v = 0; v < N_OUT; v++) {
             if (memcmp(&want[v], &got[v], sizeof(double)) != 0)
                 fail_msg("contact %d (pair type %d), value %d: batch %.17g, scalar law %.17g", q, q % n_types, v, got[v], want[v]);
         }
         /* count the regimes the random draw reached, so the test cannot pass on easy cases only */
-        const double tn = want[0] * want[9] + want[1] * want[10] + want[2] * want[11];
-        const double ft[3] = {want[0] - tn * want[9], want[1] - tn * want[10], want[2] - tn * want[11]};
+        const double tn = want[0] * n[0] + want[1] * n[1] + want[2] * n[2];
+        const double ft[3] = {want[0] - tn * n[0], want[1] - tn * n[1], want[2] - tn * n[2]};
         const double ftn = sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
         if (tn > 0 && fabs(ftn - types[q % n_types].def.friction * tn) <= 1e-9 * tn) (*slides)++;
-        const double mr = sqrt(want[6] * want[6] + want[7] * want[7] + want[8] * want[8]);
+        /* rolling torque: the part of the torques on i and j that is not the lever arms' */
+        double ci = b.ri[q] - 0.5 * want[15], cj = b.rj[q] - 0.5 * want[15], m[3];
+        for (int a = 0; a < 3; a++) m[a] = (cj * want[3 + a] - ci * want[6 + a]) / (ci + cj);
+        const double mr = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
         const double mmax = types[q % n_types].def.rolling_friction * (b.ri[q] * b.rj[q] / (b.ri[q] + b.rj[q])) * tn;
         if (mmax > 0 && fabs(mr - mmax) <= 1e-9 * mmax) (*limits)++;
     }
@@ -142,6 +135,7 @@ static void test_batch_equals_scalar_law(void **state)
     int slides = 0, limits = 0;
     for (int round = 0; round < 50; round++) check_batch(types, 4, round ? 1 + round % DEM_PAIR_BATCH : DEM_PAIR_BATCH, &slides, &limits);
     for (int round = 0; round < 20; round++) check_batch(types, 4, DEM_PAIR_BATCH, &slides, &limits);
+    for (int round = 0; round < 40; round++) check_batch(types + round % 4, 1, DEM_PAIR_BATCH, &slides, &limits);
     assert_true(slides > 50);  /* the Coulomb cap was exercised */
     assert_true(limits > 50);  /* and the rolling limit */
 }
@@ -153,6 +147,7 @@ static void test_other_rolling_models_take_the_scalar_law(void **state)
                                  props(0.6, 0.3, DEM_ROLLING_EPSD2, 3e6)};
     int slides = 0, limits = 0;
     for (int round = 0; round < 20; round++) check_batch(types, 3, DEM_PAIR_BATCH, &slides, &limits);
+    for (int round = 0; round < 20; round++) check_batch(types + round % 2, 1, DEM_PAIR_BATCH, &slides, &limits);
     assert_true(slides > 20 && limits > 20);
 }
 
