@@ -126,7 +126,6 @@ void dem_domain_destroy(dem_domain *d)
     free_wall_list(&d->walls_cur);
     free_wall_list(&d->walls_old);
     free(d->slot);
-    free(d->reaction);
     free(d->trans_start);
     free(d->trans_entry);
     free(d->cell_of);
@@ -224,7 +223,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     if (!d) return 0;
     size_t b = sizeof *d;
     size_t cap = (size_t)d->cap;
-    b += cap * (6 * 3 + 3 + 6) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia; reaction */
+    b += cap * (6 * 3 + 3) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia */
     b += cap * (sizeof(int32_t) * 5 + sizeof(dem_particle_id) + sizeof(int64_t)); /* mat cell_of perm trans_lo/hi id trans_start */
     b += (size_t)(d->walls_cur.start ? 2 * (cap + 1) * sizeof(int64_t) : 0);     /* wall list offsets */
     b += (size_t)d->cap_ids * sizeof(int32_t);

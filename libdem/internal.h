@@ -143,8 +143,6 @@ struct dem_domain {
     int32_t *trans_entry;
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
     int64_t trans_capacity;   /* entries the slot and trans_entry arrays can hold */
-    double *reaction;         /* 6 per particle: the reactions (force 3, torque 3) its partners in
-                               * the same thread's rows add during a sweep; zero between sweeps */
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
     int64_t n_cells, cap_cells;

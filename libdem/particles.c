@@ -18,10 +18,6 @@ static int reserve_particles(dem_domain *d, int64_t need)
     if (!dem_realloc_all(vec3, 6, (size_t)c * 3, sizeof(double)) || !dem_realloc_all(scalar, 3, (size_t)c, sizeof(double)) ||
         !dem_realloc_all(i32, 5, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(i64, 2, (size_t)c + 1, sizeof(int64_t)))
         return 0;
-    double *r = dem_realloc_array(d->reaction, (size_t)c * 6, sizeof(double));
-    if (!r) return 0;
-    memset(r + 6 * d->cap, 0, (size_t)(c - d->cap) * 6 * sizeof(double)); /* the sweep's invariant */
-    d->reaction = r;
     d->cap = c;
     return 1;
 }

@@ -5,15 +5,16 @@
  * order (the forward half of the cell stencil), except across periodic faces. Processing rows
  * in order, particle p's forces are therefore complete once row p is done: its own row gives
  * the i-side, and every entry naming p as partner was in an earlier row, whose reaction waits
- * in its per-particle reaction sum. p is then finished at once — reactions added, walls
- * added, closing half kick, opening half kick and drift — and nothing later reads its old state.
- * A particle named by a later row (periodic wrap) or by another thread's rows is "deferred":
- * finished after all rows are done. A particle named by another thread's rows ("shared") cannot
- * have its reactions summed as they come (two threads would add); its reactions are read back
- * from the per-entry slots instead, in list order. Either way every force is summed in the same
- * order — reactions in list order from zero, subtracted from the own-row sum (list order), then
- * walls — whatever the thread count or deferral, so results are bitwise identical for any
- * number of threads. */
+ * in its reaction sum, kept in its force and torque arrays (the old forces are not needed once
+ * the step is open; the sweep zeroes them first). p is then finished at once — reactions added,
+ * walls added, closing half kick, opening half kick and drift — and nothing later reads its old
+ * state. Such particles, named only by earlier rows of the same thread, are "direct".
+ * The others — named by a later row (periodic wrap) or by another thread's rows, where the sum
+ * cannot be built as rows come (two threads would add, or the force arrays hold the parked row
+ * sums) — are "deferred": finished after all rows are done, their reactions read back from the
+ * per-entry slots. Either way every force is summed in the same order — reactions in list
+ * order from zero, subtracted from the own-row sum (list order), then walls — whatever the
+ * thread count, so results are bitwise identical for any number of threads. */
 #include "contact_law.h"
 #include "pair_batch.h"
 #include "sweep.h"
@@ -84,15 +85,16 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     dem_pair_batch_props(b);
 }
 
-/* Whether rows outside [r0, r1) (another thread's) name particle p, or p is not in [r0, r1). */
-static inline int shared(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
+/* Whether particle p is direct for the thread of rows [r0, r1): its own, and named only by
+ * rows of it before p (trans_hi is -1 for a particle nobody names). */
+static inline int direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
 {
-    return p < r0 || p >= r1 || d->trans_lo[p] < r0 || d->trans_hi[p] >= r1;
+    return p >= r0 && p < r1 && d->trans_lo[p] >= r0 && d->trans_hi[p] < p;
 }
 
 /* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
- * torque on i added to the row sums acc (force 3, torque 3), the reaction to the partner's sum
- * unless the partner is shared. */
+ * torque on i added to the row sums acc (force 3, torque 3), the reaction to a direct
+ * partner's sum. */
 static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair, int64_t r0,
                            int64_t r1)
 {
@@ -113,30 +115,32 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
         acc[3 + a] += b->ti[a][q];
     }
     const int32_t j = b->j[q];
-    if (!shared(d, j, r0, r1)) {
-        double *rj = d->reaction + 6 * (int64_t)j;
-        for (int a = 0; a < 6; a++) rj[a] += sl[a];
+    if (direct(d, j, r0, r1)) {
+        double *fj = d->f + 3 * (int64_t)j, *tj = d->t + 3 * (int64_t)j;
+        for (int a = 0; a < 3; a++) {
+            fj[a] += sl[a];
+            tj[a] += sl[3 + a];
+        }
     }
 }
 
-/* Finish particle p: add its reactions (summed in list order: from its slots if it is shared,
- * else as summed during the sweep, which it resets) and walls to its row sums, store the
- * forces, then the kicks and drift the mode asks for. */
-static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, sweep_result *res, int is_shared)
+/* Finish particle p: add its reactions (summed in list order: as summed during the sweep if
+ * it is direct, else from its slots) and walls to its row sums f, t, store the forces, then
+ * the kicks and drift the mode asks for. */
+static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, sweep_result *res, int is_direct)
 {
     dem_domain *d = c->d;
     double r[6] = {0, 0, 0, 0, 0, 0};
-    if (is_shared) {
+    if (is_direct) {
+        for (int a = 0; a < 3; a++) {
+            r[a] = d->f[3 * p + a];
+            r[3 + a] = d->t[3 * p + a];
+        }
+    } else {
         const int32_t *te = d->trans_entry;
         for (int64_t q = d->trans_start[p]; q < d->trans_start[p + 1]; q++) {
             const double *sl = d->slot + 6 * (int64_t)te[q];
             for (int a = 0; a < 6; a++) r[a] += sl[a];
-        }
-    } else {
-        double *rp = d->reaction + 6 * p;
-        for (int a = 0; a < 6; a++) {
-            r[a] = rp[a];
-            rp[a] = 0.0;
         }
     }
     for (int a = 0; a < 3; a++) {
@@ -235,6 +239,9 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t kend = pl->start[r1];
         int64_t row = r0, k = pl->start[r0];
         double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
+        for (int64_t i = r0; i < r1; i++) /* direct particles' reaction sums start at zero */
+            if (direct(d, i, r0, r1))
+                for (int a = 0; a < 3; a++) d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
         while (row < r1) {
             const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
             gather(&c, row, k, k1, &b);
@@ -247,10 +254,10 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                 for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair, r0, r1);
                 if (row_end > k1) break; /* the row goes on in the next batch */
                 double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
-                /* named only by rows of this thread up to this one: finish now; else park the
-                 * row sums in the force arrays and finish after the barrier */
-                if (d->trans_lo[row] >= r0 && d->trans_hi[row] <= row) {
-                    finish(&c, row, f, t, &res, 0);
+                /* direct: finish now; else park the row sums in the force arrays and finish
+                 * after the barrier */
+                if (direct(d, row, r0, r1)) {
+                    finish(&c, row, f, t, &res, 1);
                 } else {
                     for (int a = 0; a < 3; a++) {
                         d->f[3 * row + a] = f[a];
@@ -264,10 +271,10 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         }
 #pragma omp barrier
         for (int64_t i = r0; i < r1; i++) {
-            if (d->trans_lo[i] >= r0 && d->trans_hi[i] <= i) continue;
+            if (direct(d, i, r0, r1)) continue;
             double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
             double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
-            finish(&c, i, f, t, &res, shared(d, i, r0, r1));
+            finish(&c, i, f, t, &res, 0);
         }
         maxdisp2 = res.maxdisp2;
         bad_nan = res.bad_nan;
