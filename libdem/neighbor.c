@@ -31,18 +31,23 @@ static int grow(void **p, int64_t *cap, int64_t need, size_t elem)
  * time; doubling would waste up to half the memory). */
 static int64_t margin(int64_t need) { return need + need / 10 + 256; }
 
-/* Grow a pair list's per-entry arrays to hold `need` entries. */
+/* Whether a per-entry capacity should change for `need` entries: too small, or more than 40 %
+ * above need (a bed that has settled from a loose start keeps its peak capacity otherwise;
+ * the hysteresis between 1.1x and 1.4x avoids resizing back and forth). */
+static int refit(int64_t need, int64_t capacity) { return need > capacity || capacity > margin(need) + need * 3 / 10; }
+
+/* Fit a pair list's per-entry arrays to hold `need` entries (contents not kept). */
 static int pair_list_reserve(pair_list *pl, int64_t need)
 {
-    if (need <= pl->capacity) return 1;
+    if (!refit(need, pl->capacity)) return 1;
     int64_t c = margin(need);
     void **i32[] = {(void **)&pl->j};
     void **u8[] = {(void **)&pl->image, (void **)&pl->active};
     void **hist[] = {(void **)&pl->hist};
-    if (!dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(u8, 2, (size_t)c, 1) ||
-        !dem_realloc_all(hist, 1, (size_t)c * 6, sizeof(double)))
-        return 0;
-    pl->capacity = c;
+    const int ok = dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) & dem_realloc_all(u8, 2, (size_t)c, 1) &
+                   dem_realloc_all(hist, 1, (size_t)c * 6, sizeof(double));
+    if (!ok && c > pl->capacity) return 0; /* every array still holds the old capacity */
+    pl->capacity = c;                      /* (a failed shrink leaves arrays larger than c) */
     return 1;
 }
 
@@ -301,13 +306,20 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     }
 
     /* per-entry force scratch and the transposed list (entries where a particle is j) */
-    if (count > d->trans_capacity) {
+    if (refit(count, d->trans_capacity)) {
         int64_t c = margin(count);
         void **slots[] = {(void **)&d->slot};
         void **te[] = {(void **)&d->trans_entry};
-        if (!dem_realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(te, 1, (size_t)c, sizeof(int32_t)))
-            return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+        const int ok = dem_realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) &
+                       dem_realloc_all(te, 1, (size_t)c, sizeof(int32_t));
+        if (!ok && c > d->trans_capacity) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
+    }
+    /* the histories are carried over: the old list's arrays may follow the new size (it is
+     * refilled at the next build; a failed shrink only keeps memory) */
+    if (refit(count, d->pairs_old.capacity) && count <= d->pairs_old.capacity) {
+        pair_list_reserve(&d->pairs_old, count);
+        d->pairs_old.count = 0;
     }
     memset(d->trans_start, 0, (size_t)(n + 1) * sizeof *d->trans_start);
     for (int64_t k = 0; k < count; k++) d->trans_start[pl->j[k] + 1]++;
