@@ -11,7 +11,7 @@ from pydem.rigs import RingShear, RingShearConfig, load
 
 @pytest.fixture(scope="module")
 def tiny():
-    return RingShear(load(RingShearConfig, "tiny")).run(seed=1)
+    return RingShear(load(RingShearConfig, "tiny", overrides=["shear_repeats=2"])).run(seed=1)
 
 
 def test_preshear_holds_the_normal_stress(tiny):
@@ -27,6 +27,17 @@ def test_friction_coefficients_are_plausible(tiny):
     assert 0.0 < tiny.metrics["inertial_number"].value < 0.05
     rho = tiny.metrics["bulk_density"].value
     assert 0.35 * 2500 < rho < 0.7 * 2500
+
+
+def test_repeated_shear_points_are_averaged(tiny):
+    """Two cycles at 50 %: mu_ie-s is the mean of the two peaks, its error their standard error,
+    and a single fraction gives no yield locus (a line needs two normal stresses)."""
+    peaks = np.array([q["tau_peak"] / q["sigma"] for q in tiny.info["shear_points"]])
+    assert [q["fraction"] for q in tiny.info["shear_points"]] == [0.5, 0.5]
+    s50 = tiny.metrics["mu_ie_s_50"]
+    assert s50.value == pytest.approx(peaks.mean(), rel=1e-12)
+    assert s50.uncertainty == pytest.approx(abs(peaks[0] - peaks[1]) / 2, rel=1e-9)
+    assert "yield_locus_slope" not in tiny.metrics
 
 
 def test_shear_stress_from_torque_closed_form():
