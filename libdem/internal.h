@@ -78,7 +78,8 @@ typedef struct tri_list {
 
 /* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the
  * partner j, the periodic image code of j, the contact histories, and whether the pair
- * touched at the last evaluation (its reaction slot then holds non-zero values). */
+ * touched at the last evaluation (its reaction slot then holds its force, where the slot
+ * is current: see `slot`). */
 typedef struct pair_list {
     int64_t n_rows;       /* particles covered */
     int64_t count, capacity;
@@ -138,7 +139,10 @@ struct dem_domain {
     wall_list walls_cur, walls_old;
     tri_list tris_cur, tris_old;
     double *slot;             /* 6 per pair entry: contact force on i (the partner gets minus
-                               * it), torque on the partner; written while the pair touches */
+                               * it), torque on the partner; zero once the pair stops touching.
+                               * Current for every entry after the last sweep of a step call
+                               * (forces_valid); during a call only for entries whose partner is
+                               * finished from its slots (deferred, sweep.c) */
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */

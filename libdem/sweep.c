@@ -28,6 +28,7 @@ typedef struct sweep_ctx {
     dem_domain *d;
     double dt_hist;   /* spring history increment (0: refresh without motion) */
     sweep_mode mode;
+    int all_slots;    /* write every touching entry's slot (else only those a deferred finish reads) */
     double shift[27][3];
     double lo[3], hi[3]; /* closed-axis bounds (+-DBL_MAX on periodic axes) */
 } sweep_ctx;
@@ -103,23 +104,27 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
     const int64_t k = b->k[q];
     const double ri = b->ri[q], rj = b->rj[q];
     if (b->overlap[q] > d->def.max_overlap_ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
-    double *h = pl->hist + 6 * k, *sl = d->slot + 6 * k;
+    double *h = pl->hist + 6 * k;
     for (int a = 0; a < 6; a++) h[a] = b->h[a][q];
-    for (int a = 0; a < 3; a++) {
-        sl[a] = b->force[a][q];
-        sl[3 + a] = b->tj[a][q];
-    }
     pl->active[k] = 1;
     for (int a = 0; a < 3; a++) {
         acc[a] += b->force[a][q];
         acc[3 + a] += b->ti[a][q];
     }
     const int32_t j = b->j[q];
-    if (direct(d, j, r0, r1)) {
+    const int j_direct = direct(d, j, r0, r1);
+    if (j_direct) {
         double *fj = d->f + 3 * (int64_t)j, *tj = d->t + 3 * (int64_t)j;
         for (int a = 0; a < 3; a++) {
-            fj[a] += sl[a];
-            tj[a] += sl[3 + a];
+            fj[a] += b->force[a][q];
+            tj[a] += b->tj[a][q];
+        }
+    }
+    if (!j_direct || c->all_slots) {
+        double *sl = d->slot + 6 * k;
+        for (int a = 0; a < 3; a++) {
+            sl[a] = b->force[a][q];
+            sl[3 + a] = b->tj[a][q];
         }
     }
 }
@@ -217,6 +222,10 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
     c.d = d;
     c.dt_hist = dt_hist;
     c.mode = mode;
+    /* the slots are read by the stress and the snapshots only where the forces belong to the
+     * positions, i.e. after the last sweep of a call: the steps before it skip the slots of
+     * direct partners (48 bytes per contact and step) */
+    c.all_slots = mode != SWEEP_CLOSE_OPEN;
     for (int s = 0; s < 27; s++)
         for (int a = 0; a < 3; a++) c.shift[s][a] = dem_image_sign[s][a] * (d->def.hi[a] - d->def.lo[a]);
     dem_sweep_bounds(d, c.lo, c.hi);
