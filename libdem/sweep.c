@@ -39,31 +39,41 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
 {
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
-    const double *x = d->x, *v = d->v, *w = d->w, *rad = d->radius, *im = d->inv_mass;
+    /* locals, so that the stores below (the batch, the rare history reset) do not make the
+     * compiler reload the list and state pointers from the domain at every entry */
+    const double *restrict x = d->x, *restrict v = d->v, *restrict w = d->w;
+    const double *restrict rad = d->radius, *restrict im = d->inv_mass;
+    const int64_t *restrict start = pl->start;
+    const int32_t *restrict pj = pl->j, *restrict mat = d->mat;
+    const uint8_t *restrict image = pl->image;
+    uint8_t *restrict active = pl->active;
+    double *restrict hist = pl->hist, *restrict slot = d->slot;
+    const pair_props *pairs = d->pairs;
+    const int n_mat = d->n_materials;
     int m = 0;
     for (int64_t i = row; k0 < k1; i++) {
-        const int64_t e1 = pl->start[i + 1] < k1 ? pl->start[i + 1] : k1;
+        const int64_t e1 = start[i + 1] < k1 ? start[i + 1] : k1;
         if (k0 >= e1) continue;
         const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i], imi = im[i];
         const double *vi = v + 3 * i, *wi = w + 3 * i;
-        const pair_props *row_pairs = d->pairs + (size_t)d->mat[i] * d->n_materials;
+        const pair_props *row_pairs = pairs + (size_t)mat[i] * n_mat;
         for (int64_t k = k0; k < e1; k++) {
-            const int32_t j = pl->j[k];
-            const double *sh = c->shift[pl->image[k]];
+            const int32_t j = pj[k];
+            const double *sh = c->shift[image[k]];
             const double dx = xi0 - (x[3 * j] + sh[0]), dy = xi1 - (x[3 * j + 1] + sh[1]), dz = xi2 - (x[3 * j + 2] + sh[2]);
             const double rj = rad[j], rsum = ri + rj;
             const double r2 = dx * dx + dy * dy + dz * dz;
             if (r2 >= rsum * rsum) {
-                if (pl->active[k]) {
-                    for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = d->slot[6 * k + a] = 0.0;
-                    pl->active[k] = 0;
+                if (active[k]) {
+                    for (int a = 0; a < 6; a++) hist[6 * k + a] = slot[6 * k + a] = 0.0;
+                    active[k] = 0;
                 }
                 continue;
             }
-            const double *vj = v + 3 * j, *wj = w + 3 * j, *h = pl->hist + 6 * k;
+            const double *vj = v + 3 * j, *wj = w + 3 * j, *h = hist + 6 * k;
             b->k[m] = k;
             b->j[m] = j;
-            b->pp[m] = &row_pairs[d->mat[j]];
+            b->pp[m] = &row_pairs[mat[j]];
             b->dx[m] = dx;
             b->dy[m] = dy;
             b->dz[m] = dz;
