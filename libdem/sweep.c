@@ -139,6 +139,40 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
     }
 }
 
+/* Opening half kick and drift of particle p (inlined into the sweep; dem_open_step() for the
+ * first step of a call). */
+static inline void open_step(dem_domain *d, int64_t p, const double *f, const double *t, double *vl, double *wl,
+                             const double *lo, const double *hi, sweep_result *res)
+{
+    const double dt = d->def.dt, half = 0.5 * dt, *g = d->def.gravity;
+    const double imp = d->inv_mass[p], iip = d->inv_inertia[p];
+    double *xp = d->x + 3 * p;
+    const double *xb = d->x_build + 3 * p;
+    double disp2 = 0.0, sum = 0.0;
+    int in = 1;
+    for (int a = 0; a < 3; a++) {
+        vl[a] += half * (f[a] * imp + g[a]);
+        wl[a] += half * t[a] * iip;
+        xp[a] += dt * vl[a];
+        const double u = xp[a] - xb[a];
+        disp2 += u * u;
+        sum += xp[a] + wl[a];
+        in &= (xp[a] >= lo[a]) & (xp[a] <= hi[a]);
+    }
+    if (disp2 > res->maxdisp2) res->maxdisp2 = disp2;
+    if (!(sum - sum == 0.0)) { /* NaN or inf somewhere in x, v (through x) or w */
+        if (p < res->bad_nan) res->bad_nan = p;
+    } else if (!in && p < res->bad_out) {
+        res->bad_out = p;
+    }
+}
+
+void dem_open_step(dem_domain *d, int64_t p, const double *f, const double *t, double *vl, double *wl,
+                   const double *lo, const double *hi, sweep_result *res)
+{
+    open_step(d, p, f, t, vl, wl, lo, hi, res);
+}
+
 /* Finish particle p: add its reactions (summed in list order: as summed during the sweep if
  * it is direct, else from its slots) and walls to its row sums f, t, store the forces, then
  * the kicks and drift the mode asks for. */
@@ -178,37 +212,10 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
         vl[a] = vp[a] + half * (f[a] * imp + g[a]);
         wl[a] = wp[a] + half * t[a] * iip;
     }
-    if (c->mode == SWEEP_CLOSE_OPEN) dem_open_step(d, p, f, t, vl, wl, c->lo, c->hi, res);
+    if (c->mode == SWEEP_CLOSE_OPEN) open_step(d, p, f, t, vl, wl, c->lo, c->hi, res);
     for (int a = 0; a < 3; a++) {
         vp[a] = vl[a];
         wp[a] = wl[a];
-    }
-}
-
-/* Opening half kick and drift of particle p (shared with the first step of a call). */
-void dem_open_step(dem_domain *d, int64_t p, const double *f, const double *t, double *vl, double *wl,
-                   const double *lo, const double *hi, sweep_result *res)
-{
-    const double dt = d->def.dt, half = 0.5 * dt, *g = d->def.gravity;
-    const double imp = d->inv_mass[p], iip = d->inv_inertia[p];
-    double *xp = d->x + 3 * p;
-    const double *xb = d->x_build + 3 * p;
-    double disp2 = 0.0, sum = 0.0;
-    int in = 1;
-    for (int a = 0; a < 3; a++) {
-        vl[a] += half * (f[a] * imp + g[a]);
-        wl[a] += half * t[a] * iip;
-        xp[a] += dt * vl[a];
-        const double u = xp[a] - xb[a];
-        disp2 += u * u;
-        sum += xp[a] + wl[a];
-        in &= (xp[a] >= lo[a]) & (xp[a] <= hi[a]);
-    }
-    if (disp2 > res->maxdisp2) res->maxdisp2 = disp2;
-    if (!(sum - sum == 0.0)) { /* NaN or inf somewhere in x, v (through x) or w */
-        if (p < res->bad_nan) res->bad_nan = p;
-    } else if (!in && p < res->bad_out) {
-        res->bad_out = p;
     }
 }
 
