@@ -33,6 +33,22 @@ def property_metrics(rig: str, store) -> list[str]:
     return [m for m in store.metric_names if any(m == w or (w.endswith("_") and m.startswith(w)) for w in wanted)]
 
 
+def noise_ceiling(store, metric: str) -> tuple[float, str]:
+    """The hold-out R^2 a perfect net would get on the design points' means: 1 - their noise
+    variance / their variance, and where the noise comes from: the pooled scatter between
+    replicates ("replicates"), else the runs' own standard errors ("within-run": repeats or
+    blocks inside a run, a lower bound on the run-to-run scatter), else nothing (nan, "")."""
+    _, y, counts, replicate_sd = store.point_table(metric)
+    _, _, run_se = store.table(metric)
+    if np.isfinite(replicate_sd):
+        noise_var, source = replicate_sd ** 2 * float(np.mean(1.0 / counts)), "replicates"
+    elif run_se.size and np.all(np.isfinite(run_se)):
+        noise_var, source = float(np.mean(run_se ** 2)) * float(np.mean(1.0 / counts)), "within-run"
+    else:
+        return float("nan"), ""
+    return (1.0 - noise_var / float(np.var(y)) if np.var(y) > 0 else float("nan")), source
+
+
 def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selection: str = "one-se") -> dict:
     from nn.export import write_c, write_weights
     from nn.mlp import select_net
@@ -43,9 +59,7 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selectio
         for metric in property_metrics(rig, store):
             # replicates averaged: the nets fit (and are judged on) each design point's mean
             x, y, counts, replicate_sd = store.point_table(metric)
-            # the R^2 a perfect net would get on these means: their replicate noise over their variance
-            noise_var = replicate_sd ** 2 * float(np.mean(1.0 / counts))
-            ceiling = 1.0 - noise_var / float(np.var(y)) if np.isfinite(replicate_sd) and np.var(y) > 0 else float("nan")
+            ceiling, noise_source = noise_ceiling(store, metric)
             t0 = time.perf_counter()
             net, table = select_net(metric, store.spec.names, x, y, sizes=sizes, restarts=restarts, seed=seed,
                                     unit=store.metric_units[store.metric_names.index(metric)], rule=selection)
@@ -56,7 +70,7 @@ def train_all(stores: dict, out: Path, sizes, restarts: int, seed: int, selectio
             i = net.info
             meta[key] = {"rig": rig, "metric": metric, "hidden": net.hidden, "unit": net.unit,
                          "runs": int(counts.sum()), "replicates": float(np.mean(counts)),
-                         "replicate_sd": replicate_sd, "r2_noise_ceiling": ceiling,
+                         "replicate_sd": replicate_sd, "r2_noise_ceiling": ceiling, "noise_source": noise_source,
                          "seconds": time.perf_counter() - t0,
                          **{k: i[k] for k in ("holdout_r2", "train_r2", "samples", "holdout_samples", "holdout_rmse", "selection",
                                      "best_hidden", "best_holdout_r2", "holdout_r2_se")},

@@ -116,14 +116,17 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
            else "the size with the best hold-out R²") + ".", "",
           "Where design points were run more than once (different seeds), the nets fit the replicate means; "
           "the noise ceiling is the R² a perfect net would reach on those means (1 − pooled replicate variance "
-          "/ replicates / variance of the means).", "",
+          "/ replicates / variance of the means). Without replicates it comes from the runs' own standard errors "
+          "(repeated shear points, blocks of a steady flow), marked \"within-run\": a lower bound on the "
+          "run-to-run noise, so an upper bound on the ceiling.", "",
           "| net | points (runs) | hidden | hold-out R² | train R² | hold-out RMSE | best size: hidden, R² ± SE | noise ceiling |",
           "|---|---|---|---|---|---|---|---|"]
     for k, m in trained["meta"].items():
         ceiling = m.get("r2_noise_ceiling", float("nan"))
         L.append(f"| {k} | {m['samples']} ({m.get('runs', m['samples'])}) | {m['hidden']} | {m['holdout_r2']:.4f} | {m['train_r2']:.4f} | "
                  f"{m['holdout_rmse']:.4g} {m['unit']} | {m['best_hidden']}, {m['best_holdout_r2']:.4f} ± "
-                 f"{m['holdout_r2_se']:.4f} | {'—' if ceiling != ceiling else f'{ceiling:.3f}'} |")
+                 f"{m['holdout_r2_se']:.4f} | {'—' if ceiling != ceiling else f'{ceiling:.3f}'}"
+                 f"{' (within-run)' if m.get('noise_source') == 'within-run' else ''} |")
     low = [k for k, m in trained["meta"].items() if m["holdout_r2"] < 0.95]
     if low:
         L += ["", f"**Below the R² ≥ 0.95 target:** {', '.join(low)} — the run-to-run scatter of these small test-scale "
