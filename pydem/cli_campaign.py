@@ -3,6 +3,7 @@
     pydem campaign run data/campaigns/ring_shear_tiny.toml --store rs.h5   # new, or continue
     pydem campaign run --store rs.h5 --samples 512                         # extend, then run
     pydem campaign run --store rs.h5 --replicates 2                        # every point once more
+    pydem campaign run --store rs.h5 --replicates 2 --points 128           # ... the first 128 points first
     pydem campaign run --store rs.h5 --dask tcp://scheduler:8786
     pydem campaign status rs.h5
     pydem campaign export rs.h5 --csv rs.csv
@@ -27,6 +28,7 @@ def add_parser(sub):
     run.add_argument("--dask", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     run.add_argument("--retry-failed", action="store_true", help="run the failed samples again")
     run.add_argument("--max-runs", type=int, help="stop after this many runs (the rest stay pending)")
+    run.add_argument("--points", type=int, help="run only the runs of the first N design points (the rest stay pending)")
     run.add_argument("--quiet", action="store_true")
     st = csub.add_parser("status", help="counts, timings, failures and provenance of a store")
     st.add_argument("store")
@@ -46,7 +48,7 @@ def main(args) -> int:
             print(f"written {args.csv}")
         else:
             target, replicates = args.samples, args.replicates
-            for flag, value in (("--samples", target), ("--replicates", replicates)):
+            for flag, value in (("--samples", target), ("--replicates", replicates), ("--points", args.points)):
                 if value is not None and value < 1:
                     raise SpecError(f"{flag}: expected a positive count, got {value}")
             if Path(args.store).exists():
@@ -68,7 +70,7 @@ def main(args) -> int:
             if target or replicates:
                 c.grow(target, replicates)
             counts = c.run(workers=args.workers, dask=args.dask, retry_failed=args.retry_failed,
-                           max_runs=args.max_runs, quiet=args.quiet)
+                           max_runs=args.max_runs, quiet=args.quiet, points=args.points)
             print(f"campaign {args.store}: done {counts['done']}, failed {counts['failed']}, pending {counts['pending']}")
     except (SpecError, StoreError) as exc:
         print(f"pydem campaign: {exc}", file=sys.stderr)

@@ -140,8 +140,10 @@ class Campaign:
         return np.array([sample_seed(self.store.spec.seed, i) for i in range(start, start + n)])
 
     def run(self, workers: int | None = None, dask: str | None = None, retry_failed: bool = False,
-            max_runs: int | None = None, quiet: bool = False) -> dict[str, int]:
-        """Runs the pending samples (and failed ones with retry_failed); saves after each."""
+            max_runs: int | None = None, quiet: bool = False, points: int | None = None) -> dict[str, int]:
+        """Runs the pending samples (and failed ones with retry_failed); saves after each. `points`:
+        only the runs of the first `points` design points (a Sobol design's first 2^k points are
+        balanced: replicate them before extending them), the rest stay pending."""
         s = self.store
         rig_cls = RIGS[s.spec.rig][0]
         made_with = s.rig_protocol
@@ -152,7 +154,7 @@ class Campaign:
                              f"{s.provenance.get('git_commit', 'unknown')}.")
         s.lock()
         try:
-            todo = s.pending(retry_failed)[:max_runs]
+            todo = [i for i in s.pending(retry_failed) if points is None or s.points[i] < points][:max_runs]
             if not todo:
                 return s.counts()
             now = provenance()  # every session that adds runs is recorded (code version, machine)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import torch
 
-from nn.mlp import MLP, Scaler, r2_score, select_net, train_net
+from nn.mlp import MLP, Scaler, holdout_split, r2_score, select_net, train_net
 from nn.scg import SCG
 
 
@@ -126,3 +126,21 @@ def test_scaler_round_trip_and_constant_column():
     import pytest
     with pytest.raises(ValueError, match="constant"):
         Scaler.fit(np.array([[1.0, 2.0], [1.0, 3.0]]))
+
+
+def test_selection_reaches_the_noise_floor_on_campaign_sized_noisy_data():
+    """~110 noisy runs, the size of a campaign: the selected nets must come within reach of the
+    true function's own hold-out R^2 (the most any net can get on noisy targets). Validation
+    early stopping on ~14 points is itself noisy; stopping after 6 failures (MATLAB's default)
+    stopped SCG after 10-30 epochs, ~0.06 below the truth on average here (0.17 on one draw)."""
+    truth = lambda x: 0.3 + 0.5 * (1 - np.exp(-4 * x[:, 0])) + 0.25 * x[:, 1] * (1 - x[:, 0]) ** 2 + 0.05 * np.sin(6 * x[:, 1])
+    gaps = []
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        x = rng.uniform([0.05, 0.0, 0.2], [1.0, 0.6, 0.9], size=(110, 3))
+        y = truth(x) + rng.normal(0, 0.025, len(x))
+        net, _ = select_net("p", ["friction", "rolling_friction", "restitution"], x, y, sizes=[2, 4, 8], restarts=2)
+        hold = holdout_split(len(y), 0.15, 0)[1]
+        gaps.append(r2_score(y[hold], truth(x[hold])) - net.info["best_holdout_r2"])
+    # tolerance: a 16-point hold-out R^2 scatters by ~0.02 between equally good nets
+    assert np.mean(gaps) < 0.025, gaps
