@@ -104,7 +104,7 @@ bench: setup lib $(BENCH_BIN)
 # the main job: calibrate glass microbeads from the shipped campaigns and measurements
 # (train + select the MLPs, export, screen 2^20 combinations natively, narrow, confirm by DEM,
 # report in build/calibration/report.md)
-DEMO_CAMPAIGNS := data/campaigns/ring_shear_tiny.h5 data/campaigns/aor_default.h5
+DEMO_CAMPAIGNS := data/campaigns/ring_shear_cell.h5 data/campaigns/aor_default.h5
 demo: setup lib
 	@$(MAKE) --no-print-directory pydem
 	.venv/bin/pydem calibrate --measurements data/measurements/glass_microbeads.csv --material glass_microbeads \
