@@ -229,6 +229,10 @@ class Campaign:
                  f"  design points {s.design_points} x {spec.replicates} replicate(s) = {len(s)} runs: done {c['done']}, "
                  f"failed {c['failed']}, pending {c['pending']}"]
         done = s.status == DONE
+        if spec.replicates > 1 and done.any():  # how far each replicate round has got
+            finished = np.bincount(s.points[done], minlength=s.design_points)
+            lines.append("  design points with " + ", ".join(f"{k} finished run(s): {int((finished == k).sum())}"
+                                                         for k in range(int(finished.max()) + 1)))
         if done.any():
             w = s.wall[done]
             lines.append(f"  wall time per run: median {np.median(w):.1f} s, total {w.sum() / 3600:.2f} h of worker time")

@@ -153,6 +153,8 @@ def test_replicates_grow_by_replicate_and_average_per_point(tmp_path):
         s.record_done(i, {"m": (v, 0.0, "")}, 1.0)
     s.save()
     s = CampaignStore.open(tmp_path / "r.h5")
+    assert "design points with 0 finished run(s): 0, 1 finished run(s): 2, 2 finished run(s): 3" in \
+        Campaign.open(tmp_path / "r.h5").status_text()
     x, y, counts, sd = s.point_table("m")
     assert np.array_equal(y, [1.5, 2.0, 4.0, 7.0, 9.0]) and list(counts) == [2, 2, 2, 1, 1]
     assert np.array_equal(x, s.params[[0, 1, 2, 6, 7]])
