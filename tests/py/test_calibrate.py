@@ -53,6 +53,8 @@ def test_calibration_job_end_to_end(aor_campaign, tmp_path):
     assert kept.shape == (st["admissible"], 3)  # friction, rolling_friction, the predicted angle
     report = (out / "report.md").read_text()
     assert "Confirming DEM runs" in report and "hold-out R²" in report
+    for key, meta in summary["nets"].items():  # every net below the target is named, with why
+        assert (f"- {key}: " in report and "noise ceiling" in report) == (meta["holdout_r2"] < 0.95), key
     r = subprocess.run([sys.executable, "-m", "pydem", "compare", str(meas), "--material", "beads", "--nets",
                         str(out / "nets"), "--params", ",".join(f"{k}={v}" for k, v in summary["best"].items())],
                        cwd=ROOT, capture_output=True, text=True)
