@@ -133,7 +133,10 @@ def write(out: Path, summary: dict, trained: dict, sc, cnets, res_sur, res_dem, 
             ceiling, se = m.get("r2_noise_ceiling", float("nan")), m.get("holdout_r2_se", 0.0)
             if not math.isfinite(ceiling):
                 return "no noise estimate (no replicates or run uncertainties)"
-            if ceiling < 0.95 or m["holdout_r2"] >= ceiling - se:
+            if ceiling < 0.95:
+                return (f"its noise ceiling {ceiling:.3f} is below the target whatever the net: more replicates per "
+                        "design point (or a less noisy rig) raise it, more design points do not")
+            if m["holdout_r2"] >= ceiling - se:
                 return (f"at its noise ceiling {ceiling:.3f}: more replicates per design point (or a less noisy rig) "
                         "raise it, more design points do not")
             return f"below its noise ceiling {ceiling:.3f} by more than the hold-out SE: more design points should help"
