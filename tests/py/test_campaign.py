@@ -103,10 +103,6 @@ def test_kill_9_mid_run_loses_nothing_and_resumes(tmp_path):
     assert len((tmp_path / "c.csv").read_text().splitlines()) == 9
 
 
-def s_status(path) -> list[int]:
-    return CampaignStore.open(path).status.tolist()
-
-
 def test_extend_failures_lock_and_corrupt_store(tmp_path):
     c = Campaign.create(tmp_path / "s.h5", spec(samples=2))
     with pytest.raises(StoreError, match="exists already"):
@@ -115,7 +111,7 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
     c.store.save()
     c.grow(4)
     counts = c.run(workers=2, points=2, quiet=True)  # of the first two points only 0 is pending; the failure stays
-    assert counts == {"pending": 2, "done": 1, "failed": 1} and s_status(tmp_path / "s.h5") == [DONE, FAILED, 0, 0]
+    assert counts == {"pending": 2, "done": 1, "failed": 1} and CampaignStore.open(tmp_path / "s.h5").status.tolist() == [DONE, FAILED, 0, 0]
     counts = c.run(workers=2, max_runs=1, quiet=True)
     assert counts == {"pending": 1, "done": 2, "failed": 1}
     s = CampaignStore.open(tmp_path / "s.h5")
