@@ -34,13 +34,16 @@ typedef struct sweep_ctx {
 } sweep_ctx;
 
 /* Gathers the contacts among list entries [k0, k1) (the first in row `row`) into the batch;
- * an entry whose spheres no longer touch forgets its springs and clears its slot once. */
+ * an entry whose spheres no longer touch forgets its springs and clears its slot once.
+ * Two passes: the distance test writes every entry's geometry at the next free batch place
+ * and advances it only for touching pairs (branch-free: whether a pair touches is a coin
+ * toss the branch predictor loses), then the touching ones get the rest of their data. */
 static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair_batch *b)
 {
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
-    /* locals, so that the stores below (the batch, the rare history reset) do not make the
-     * compiler reload the list and state pointers from the domain at every entry */
+    /* locals, so that the stores below do not make the compiler reload the list and state
+     * pointers from the domain at every entry */
     const double *restrict x = d->x, *restrict v = d->v, *restrict w = d->w;
     const double *restrict rad = d->radius, *restrict im = d->inv_mass;
     const int64_t *restrict start = pl->start;
@@ -50,47 +53,52 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     double *restrict hist = pl->hist, *restrict slot = d->slot;
     const pair_props *pairs = d->pairs;
     const int n_mat = d->n_materials;
-    int m = 0;
+    int m = 0, lost = 0;
+    int32_t row_of[DEM_PAIR_BATCH]; /* the row of each touching entry, for the second pass */
+    int64_t lost_k[DEM_PAIR_BATCH]; /* entries that stopped touching */
     for (int64_t i = row; k0 < k1; i++) {
         const int64_t e1 = start[i + 1] < k1 ? start[i + 1] : k1;
-        if (k0 >= e1) continue;
-        const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i], imi = im[i];
-        const double *vi = v + 3 * i, *wi = w + 3 * i;
-        const pair_props *row_pairs = pairs + (size_t)mat[i] * n_mat;
+        const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
         for (int64_t k = k0; k < e1; k++) {
             const int32_t j = pj[k];
             const double *sh = c->shift[image[k]];
             const double dx = xi0 - (x[3 * j] + sh[0]), dy = xi1 - (x[3 * j + 1] + sh[1]), dz = xi2 - (x[3 * j + 2] + sh[2]);
             const double rj = rad[j], rsum = ri + rj;
             const double r2 = dx * dx + dy * dy + dz * dz;
-            if (r2 >= rsum * rsum) {
-                if (active[k]) {
-                    for (int a = 0; a < 6; a++) hist[6 * k + a] = slot[6 * k + a] = 0.0;
-                    active[k] = 0;
-                }
-                continue;
-            }
-            const double *vj = v + 3 * j, *wj = w + 3 * j, *h = hist + 6 * k;
+            const int touch = r2 < rsum * rsum;
             b->k[m] = k;
             b->j[m] = j;
-            b->pp[m] = &row_pairs[mat[j]];
             b->dx[m] = dx;
             b->dy[m] = dy;
             b->dz[m] = dz;
             b->r2[m] = r2;
             b->ri[m] = ri;
             b->rj[m] = rj;
-            b->imi[m] = imi;
-            b->imj[m] = im[j];
-            for (int a = 0; a < 3; a++) {
-                b->dv[a][m] = vi[a] - vj[a];
-                b->wi[a][m] = wi[a];
-                b->wj[a][m] = wj[a];
-            }
-            for (int a = 0; a < 6; a++) b->h[a][m] = h[a];
-            m++;
+            row_of[m] = (int32_t)(i - row);
+            m += touch;
+            lost_k[lost] = k;
+            lost += (!touch) & (active[k] != 0);
         }
         k0 = e1;
+    }
+    for (int q = 0; q < lost; q++) {
+        const int64_t k = lost_k[q];
+        for (int a = 0; a < 6; a++) hist[6 * k + a] = slot[6 * k + a] = 0.0;
+        active[k] = 0;
+    }
+    for (int q = 0; q < m; q++) {
+        const int64_t i = row + row_of[q], k = b->k[q];
+        const int32_t j = b->j[q];
+        const double *vi = v + 3 * i, *wi = w + 3 * i, *vj = v + 3 * j, *wj = w + 3 * j, *h = hist + 6 * k;
+        b->pp[q] = &pairs[(size_t)mat[i] * n_mat + mat[j]];
+        b->imi[q] = im[i];
+        b->imj[q] = im[j];
+        for (int a = 0; a < 3; a++) {
+            b->dv[a][q] = vi[a] - vj[a];
+            b->wi[a][q] = wi[a];
+            b->wj[a][q] = wj[a];
+        }
+        for (int a = 0; a < 6; a++) b->h[a][q] = h[a];
     }
     b->m = m;
     dem_pair_batch_props(b);
