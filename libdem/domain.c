@@ -87,6 +87,7 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
     d->def = *def;
     d->rayleigh_cache = -1.0;
     d->need_rebuild = 1;
+    d->single_material = -1;
     *out = d;
     return DEM_OK;
 }
@@ -131,6 +132,7 @@ void dem_domain_destroy(dem_domain *d)
     free(d->cell_of);
     free(d->trans_lo);
     free(d->trans_hi);
+    free(d->is_direct);
     free(d->cell_start);
     free(d->perm);
     free(d->cursor);
@@ -224,7 +226,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     size_t b = sizeof *d;
     size_t cap = (size_t)d->cap;
     b += cap * (6 * 3 + 3) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia */
-    b += cap * (sizeof(int32_t) * 5 + sizeof(dem_particle_id) + sizeof(int64_t)); /* mat cell_of perm trans_lo/hi id trans_start */
+    b += cap * (sizeof(int32_t) * 5 + sizeof(dem_particle_id) + sizeof(int64_t) + 1); /* mat cell_of perm trans_lo/hi id trans_start is_direct */
     b += (size_t)(d->walls_cur.start ? 2 * (cap + 1) * sizeof(int64_t) : 0);     /* wall list offsets */
     b += (size_t)d->cap_ids * sizeof(int32_t);
     b += (size_t)d->cap_cells * sizeof(int64_t) + (size_t)d->cap_cursor * sizeof(int64_t);

@@ -146,6 +146,8 @@ struct dem_domain {
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
+    uint8_t *is_direct;       /* n: whether the sweep finishes the particle as it goes, set by
+                               * each sweep for its thread's own rows (sweep.c) */
     int64_t trans_capacity;   /* entries the slot and trans_entry arrays can hold */
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
@@ -157,6 +159,8 @@ struct dem_domain {
     double cell_size[3];
     int need_rebuild;
     double r_max;             /* largest radius present */
+    int32_t single_material;  /* the material of every particle, or < 0 if they differ (or
+                               * there are none); set by the neighbour build */
 
     uint64_t seed;            /* the caller's run seed, recorded in snapshots */
 

@@ -203,12 +203,15 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     /* live particles, largest radius */
     int64_t n = 0;
     double rmax = 0.0;
+    int32_t material = -1; /* the one material of every particle, or -2 */
     for (int64_t i = 0; i < n_old; i++) {
         if (remove_mask && remove_mask[i]) continue;
         n++;
         if (d->radius[i] > rmax) rmax = d->radius[i];
+        material = material == -1 || material == d->mat[i] ? d->mat[i] : -2;
     }
     d->r_max = rmax;
+    d->single_material = material;
     dem_status s = choose_cells(d, n);
     if (s != DEM_OK) return s;
 

@@ -28,12 +28,16 @@ static int takes_scalar_law(const pair_props *pp)
     return pp->n_effects > 0 || (pp->def.rolling_model != DEM_ROLLING_EPSD2 && pp->def.rolling_friction > 0.0);
 }
 
-void dem_pair_batch_props(pair_batch *b)
+void dem_pair_batch_props(pair_batch *b, const pair_props *all)
 {
     const int m = b->m;
-    int same = 1;
-    for (int q = 1; q < m; q++) same &= b->pp[q] == b->pp[0];
-    b->uniform = m > 0 && same ? b->pp[0] : NULL;
+    if (all) {
+        b->uniform = all;
+    } else {
+        int same = 1;
+        for (int q = 1; q < m; q++) same &= b->pp[q] == b->pp[0];
+        b->uniform = m > 0 && same ? b->pp[0] : NULL;
+    }
     if (b->uniform) {
         const uint8_t sc = (uint8_t)takes_scalar_law(b->uniform);
         memset(b->scalar, sc, (size_t)m);
@@ -210,7 +214,7 @@ void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist
         dem_pair_batch_contact_in(b, q, &in, &ci, &cj);
         for (int a = 0; a < 6; a++) hist[a] = list_hist[6 * b->k[q] + a]; /* the batch loop moved b->h */
         contact_out o;
-        contact_law(b->pp[q], &in, dt, hist, hist + 3, &o);
+        contact_law(b->uniform ? b->uniform : b->pp[q], &in, dt, hist, hist + 3, &o);
         for (int a = 0; a < 6; a++) b->h[a][q] = hist[a];
         double ti[3], tj[3];
         contact_torques(&o, ci, cj, ti, tj);

@@ -25,7 +25,7 @@ typedef struct pair_batch {
     int64_t k[DEM_PAIR_BATCH];
     int32_t j[DEM_PAIR_BATCH];
     uint8_t scalar[DEM_PAIR_BATCH];     /* 1: evaluate with contact_law() */
-    const pair_props *pp[DEM_PAIR_BATCH];
+    const pair_props *pp[DEM_PAIR_BATCH]; /* unset when `uniform` came from the caller */
     double dx[DEM_PAIR_BATCH], dy[DEM_PAIR_BATCH], dz[DEM_PAIR_BATCH], r2[DEM_PAIR_BATCH];
     double ri[DEM_PAIR_BATCH], rj[DEM_PAIR_BATCH], imi[DEM_PAIR_BATCH], imj[DEM_PAIR_BATCH];
     double dv[3][DEM_PAIR_BATCH], wi[3][DEM_PAIR_BATCH], wj[3][DEM_PAIR_BATCH];
@@ -37,9 +37,11 @@ typedef struct pair_batch {
     double force[3][DEM_PAIR_BATCH], ti[3][DEM_PAIR_BATCH], tj[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH];
 } pair_batch;
 
-/* After the gather (pp[] set): the scalar flags, and either `uniform` (one pair type, the
- * common case: the law reads its constants once) or the per-contact constant arrays. */
-void dem_pair_batch_props(pair_batch *b);
+/* After the gather: the scalar flags, and either `uniform` (one pair type, the common case:
+ * the law reads its constants once) or the per-contact constant arrays. `all`: the pair type
+ * of every contact when the caller knows it (one particle material; pp[] is then not read
+ * or set), else NULL and pp[] holds each contact's. */
+void dem_pair_batch_props(pair_batch *b, const pair_props *all);
 
 /* The contact law of every non-scalar contact of the batch (dt: spring history increment). */
 void dem_pair_batch_law(pair_batch *b, double dt);

@@ -86,11 +86,14 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
         for (int a = 0; a < 6; a++) hist[6 * k + a] = slot[6 * k + a] = 0.0;
         active[k] = 0;
     }
+    /* one particle material (the usual case): one pair type, known without looking */
+    const int32_t one = d->single_material;
+    const pair_props *all = one >= 0 ? &pairs[(size_t)one * n_mat + one] : NULL;
     for (int q = 0; q < m; q++) {
         const int64_t i = row + row_of[q], k = b->k[q];
         const int32_t j = b->j[q];
         const double *vi = v + 3 * i, *wi = w + 3 * i, *vj = v + 3 * j, *wj = w + 3 * j, *h = hist + 6 * k;
-        b->pp[q] = &pairs[(size_t)mat[i] * n_mat + mat[j]];
+        if (!all) b->pp[q] = &pairs[(size_t)mat[i] * n_mat + mat[j]];
         b->imi[q] = im[i];
         b->imj[q] = im[j];
         for (int a = 0; a < 3; a++) {
@@ -101,14 +104,20 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
         for (int a = 0; a < 6; a++) b->h[a][q] = h[a];
     }
     b->m = m;
-    dem_pair_batch_props(b);
+    dem_pair_batch_props(b, all);
 }
 
 /* Whether particle p is direct for the thread of rows [r0, r1): its own, and named only by
- * rows of it before p (trans_hi is -1 for a particle nobody names). */
+ * rows of it before p (trans_hi is -1 for a particle nobody names). Each sweep stores it for
+ * its own rows in is_direct, which the thread then reads (never another thread's part). */
 static inline int direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
 {
     return p >= r0 && p < r1 && d->trans_lo[p] >= r0 && d->trans_hi[p] < p;
+}
+
+static inline int partner_direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
+{
+    return p >= r0 && p < r1 && d->is_direct[p];
 }
 
 /* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
@@ -130,7 +139,7 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
         acc[3 + a] += b->ti[a][q];
     }
     const int32_t j = b->j[q];
-    const int j_direct = direct(d, j, r0, r1);
+    const int j_direct = partner_direct(d, j, r0, r1);
     if (j_direct) {
         double *fj = d->f + 3 * (int64_t)j, *tj = d->t + 3 * (int64_t)j;
         for (int a = 0; a < 3; a++) {
@@ -273,9 +282,11 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t kend = pl->start[r1];
         int64_t row = r0, k = pl->start[r0];
         double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
-        for (int64_t i = r0; i < r1; i++) /* direct particles' reaction sums start at zero */
-            if (direct(d, i, r0, r1))
+        for (int64_t i = r0; i < r1; i++) { /* direct particles' reaction sums start at zero */
+            d->is_direct[i] = (uint8_t)direct(d, i, r0, r1);
+            if (d->is_direct[i])
                 for (int a = 0; a < 3; a++) d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
+        }
         while (row < r1) {
             const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
             gather(&c, row, k, k1, &b);
@@ -290,7 +301,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                 double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
                 /* direct: finish now; else park the row sums in the force arrays and finish
                  * after the barrier */
-                if (direct(d, row, r0, r1)) {
+                if (d->is_direct[row]) {
                     finish(&c, row, f, t, &res, 1);
                 } else {
                     for (int a = 0; a < 3; a++) {
@@ -305,7 +316,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         }
 #pragma omp barrier
         for (int64_t i = r0; i < r1; i++) {
-            if (direct(d, i, r0, r1)) continue;
+            if (d->is_direct[i]) continue;
             double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
             double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
             finish(&c, i, f, t, &res, 0);
