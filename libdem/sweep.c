@@ -53,6 +53,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     double *restrict hist = pl->hist, *restrict slot = d->slot;
     const pair_props *pairs = d->pairs;
     const int n_mat = d->n_materials;
+    const int periodic = d->def.periodic[0] || d->def.periodic[1] || d->def.periodic[2];
     int m = 0, lost = 0;
     int32_t row_of[DEM_PAIR_BATCH]; /* the row of each touching entry, for the second pass */
     int64_t lost_k[DEM_PAIR_BATCH]; /* entries that stopped touching */
@@ -61,8 +62,14 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
         const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
         for (int64_t k = k0; k < e1; k++) {
             const int32_t j = pj[k];
-            const double *sh = c->shift[image[k]];
-            const double dx = xi0 - (x[3 * j] + sh[0]), dy = xi1 - (x[3 * j + 1] + sh[1]), dz = xi2 - (x[3 * j + 2] + sh[2]);
+            double xj0 = x[3 * j], xj1 = x[3 * j + 1], xj2 = x[3 * j + 2];
+            if (periodic) { /* the partner's periodic image (a zero shift elsewhere) */
+                const double *sh = c->shift[image[k]];
+                xj0 += sh[0];
+                xj1 += sh[1];
+                xj2 += sh[2];
+            }
+            const double dx = xi0 - xj0, dy = xi1 - xj1, dz = xi2 - xj2;
             const double rj = rad[j], rsum = ri + rj;
             const double r2 = dx * dx + dy * dy + dz * dz;
             const int touch = r2 < rsum * rsum;
@@ -77,7 +84,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
             row_of[m] = (int32_t)(i - row);
             m += touch;
             lost_k[lost] = k;
-            lost += (!touch) & (active[k] != 0);
+            lost += active[k] > touch; /* active is 0 or 1: it was touching and is no longer */
         }
         k0 = e1;
     }
