@@ -30,6 +30,8 @@ typedef struct sweep_ctx {
     sweep_mode mode;
     int all_slots;    /* write every touching entry's slot (else only those a deferred finish reads) */
     double shift[27][3];
+    int periodic;     /* any periodic axis: partners may be images */
+    const pair_props *all_pairs; /* the pair type of every contact (one particle material), or NULL */
     double lo[3], hi[3]; /* closed-axis bounds (+-DBL_MAX on periodic axes) */
 } sweep_ctx;
 
@@ -53,7 +55,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     double *restrict hist = pl->hist, *restrict slot = d->slot;
     const pair_props *pairs = d->pairs;
     const int n_mat = d->n_materials;
-    const int periodic = d->def.periodic[0] || d->def.periodic[1] || d->def.periodic[2];
+    const int periodic = c->periodic;
     int m = 0, lost = 0;
     int32_t row_of[DEM_PAIR_BATCH]; /* the row of each touching entry, for the second pass */
     int64_t lost_k[DEM_PAIR_BATCH]; /* entries that stopped touching */
@@ -93,9 +95,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
         for (int a = 0; a < 6; a++) hist[6 * k + a] = slot[6 * k + a] = 0.0;
         active[k] = 0;
     }
-    /* one particle material (the usual case): one pair type, known without looking */
-    const int32_t one = d->single_material;
-    const pair_props *all = one >= 0 ? &pairs[(size_t)one * n_mat + one] : NULL;
+    const pair_props *all = c->all_pairs;
     for (int q = 0; q < m; q++) {
         const int64_t i = row + row_of[q], k = b->k[q];
         const int32_t j = b->j[q];
@@ -270,6 +270,10 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
     for (int s = 0; s < 27; s++)
         for (int a = 0; a < 3; a++) c.shift[s][a] = dem_image_sign[s][a] * (d->def.hi[a] - d->def.lo[a]);
     dem_sweep_bounds(d, c.lo, c.hi);
+    c.periodic = d->def.periodic[0] || d->def.periodic[1] || d->def.periodic[2];
+    /* one particle material (the usual case): one pair type, known without looking */
+    const int32_t one = d->single_material;
+    c.all_pairs = one >= 0 ? &d->pairs[(size_t)one * d->n_materials + one] : NULL;
     const int64_t n = d->n;
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_wall = INT64_MAX, bad_pair = INT64_MAX;
