@@ -17,6 +17,13 @@
 
 #define DEM_PAIR_BATCH 64 /* contacts per batch: ~60 KB of arrays, in L2 */
 
+/* Intermediates the law's stages pass on (pair_batch.c). */
+typedef struct pair_batch_scratch {
+    double n[3][DEM_PAIR_BATCH], vt[3][DEM_PAIR_BATCH]; /* unit normal, tangential velocity */
+    double ci[DEM_PAIR_BATCH], cj[DEM_PAIR_BATCH], r_eff[DEM_PAIR_BATCH];
+    double kt[DEM_PAIR_BATCH], gt[DEM_PAIR_BATCH], fn[DEM_PAIR_BATCH];
+} pair_batch_scratch;
+
 typedef struct pair_batch {
     int m;                              /* contacts in the batch */
     int any_scalar;
@@ -35,6 +42,7 @@ typedef struct pair_batch {
     double friction[DEM_PAIR_BATCH], rolling[DEM_PAIR_BATCH]; /* rolling: mu_r of EPSD2 pairs, else 0 */
     /* results: force on i, torques on i and on j, overlap */
     double force[3][DEM_PAIR_BATCH], ti[3][DEM_PAIR_BATCH], tj[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH];
+    pair_batch_scratch s;
 } pair_batch;
 
 /* After the gather: the scalar flags, and either `uniform` (one pair type, the common case:
