@@ -13,12 +13,51 @@
  * (contact springs start empty, so give --settle a few hundred steps after --load); this is
  * for quick profiling, the committed results settle from the lattice. */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* syscall() */
 #include "dem/dem.h"
 #include "lattice.h"
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef __linux__
+#include <linux/perf_event.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
+/* The calling thread's processor cycles (user space) from the hardware counter, or -1 where
+ * the machine or its settings offer none. Why: the VMs this runs on change speed by +-15 %
+ * over minutes (and a session's machine type is not always the same), so particle-steps per
+ * second alone cannot compare runs of different hours; cycles per particle-step can. Counted
+ * for the main thread only, so meaningful for 1-thread runs. */
+static int cycle_counter_open(void)
+{
+#ifdef __linux__
+    struct perf_event_attr a;
+    memset(&a, 0, sizeof a);
+    a.type = PERF_TYPE_HARDWARE;
+    a.size = sizeof a;
+    a.config = PERF_COUNT_HW_CPU_CYCLES;
+    a.exclude_kernel = 1;
+    a.exclude_hv = 1;
+    return (int)syscall(SYS_perf_event_open, &a, 0, -1, -1, 0);
+#else
+    return -1;
+#endif
+}
+
+static double cycle_counter_read(int fd)
+{
+#ifdef __linux__
+    uint64_t v;
+    if (fd >= 0 && read(fd, &v, sizeof v) == (ssize_t)sizeof v) return (double)v;
+#else
+    (void)fd;
+#endif
+    return -1.0;
+}
 
 static double now_s(void)
 {
@@ -183,13 +222,19 @@ int main(int argc, char **argv)
     snprintf(list, sizeof list, "%s", threads_arg);
     int thread_counts[16], n_counts = 0;
     for (char *tok = strtok(list, ","); tok && n_counts < 16; tok = strtok(NULL, ",")) thread_counts[n_counts++] = atoi(tok);
+    const int cycles_fd = cycle_counter_open();
     for (int run = 0; run < repeat * n_counts; run++) {
         int nt = thread_counts[run % n_counts];
         dem_domain_set_num_threads(d, nt);
         dem_domain_profile_reset(d);
+        const double c1 = cycle_counter_read(cycles_fd);
         double t1 = now_s();
         if ((s = dem_domain_step(d, steps)) != DEM_OK) die(d, s, "timed run");
         double el = now_s() - t1;
+        const double c2 = cycle_counter_read(cycles_fd);
+        /* cycles per particle-step and the clock they ran at (1 thread, where counted) */
+        const double cps = nt == 1 && c1 >= 0 && c2 >= 0 ? (c2 - c1) / ((double)n * steps) : -1.0;
+        const double ghz = cps > 0 ? (c2 - c1) / el / 1e9 : -1.0;
         dem_profile pr;
         dem_diagnostics g;
         dem_domain_diagnostics(d, &g);
@@ -208,18 +253,25 @@ int main(int argc, char **argv)
         long rss = peak_rss_kb();
         printf("N=%lld mu_r=%.2f threads=%d: %.3f M particle-steps/s  (%.2f s for %d steps)  contacts/particle %.2f  "
                "split: neighbour %.1f%% force sweep %.1f%% (of which integration ~%.1f%%)  builds %lld  list entries/particle %.2f  "
-               "libdem memory %.0f B/particle  peak RSS %.1f MiB (%.0f B/particle)\n",
+               "libdem memory %.0f B/particle  peak RSS %.1f MiB (%.0f B/particle)",
                (long long)n, mu_r, nt, rate / 1e6, el, steps, cpp, 100 * pr.neighbor_s / el,
                100 * (pr.contact_s + pr.integrate_s) / el, 100 * integ_frac, (long long)pr.neighbor_builds, (double)pr.neighbor_pairs / (double)n, mem_pp,
                rss / 1024.0,
                rss * 1024.0 / (double)n);
+        if (cps > 0) printf("  %.0f cycles/particle-step at %.2f GHz", cps, ghz);
+        printf("\n");
+        char cyc[64] = ",";
+        if (cps > 0) snprintf(cyc, sizeof cyc, "%.1f,%.3f", cps, ghz);
         if (out)
-            fprintf(out, "%lld,%.2f,%d,%d,%.4f,%.3f,%.2f,%.3f,%.3f,%.3f,%lld,%.0f,%.1f,%.1f\n", (long long)n, mu_r, nt,
+            fprintf(out, "%lld,%.2f,%d,%d,%.4f,%.3f,%.2f,%.3f,%.3f,%.3f,%lld,%.0f,%.1f,%.1f,%s\n", (long long)n, mu_r, nt,
                     steps, rate / 1e6, el, cpp, pr.neighbor_s / el, (pr.contact_s + pr.integrate_s) / el, integ_frac,
-                    (long long)pr.neighbor_builds, mem_pp, rss / 1024.0, settle_s);
+                    (long long)pr.neighbor_builds, mem_pp, rss / 1024.0, settle_s, cyc);
         fflush(stdout);
     }
     if (out) fclose(out);
+#ifdef __linux__
+    if (cycles_fd >= 0) close(cycles_fd);
+#endif
     dem_domain_destroy(d);
     return 0;
 }
