@@ -288,7 +288,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t r0 = n * tid / nth, r1 = n * (tid + 1) / nth;
         sweep_result res;
         dem_sweep_result_init(&res);
-        pair_batch b; /* ~55 KB on the thread's stack */
+        pair_batch b; /* ~27 KB on the thread's stack */
         pair_list *pl = &d->pairs_cur;
         const int64_t kend = pl->start[r1];
         int64_t row = r0, k = pl->start[r0];
