@@ -8,6 +8,14 @@
 #include <math.h>
 #include <string.h>
 
+/* The stage loops write distinct batch slots: tell GCC so it vectorises without run-time
+ * overlap checks. */
+#if defined(__GNUC__) && !defined(__clang__)
+#define DEM_IVDEP _Pragma("GCC ivdep")
+#else
+#define DEM_IVDEP
+#endif
+
 /* vec_project_keep_length() of contact_law.h on three scalars (so the loop stays vectorisable). */
 DEM_INLINE void keep_in_plane(double *x0, double *x1, double *x2, double n0, double n1, double n2)
 {
@@ -80,9 +88,7 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int 
     /* stage 1: geometry (unit normal from j to i, overlap, lever arms, contact-point
      * velocity), stiffnesses, normal force (Hertz spring + restitution damper, no attraction)
      * and tangential velocity */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC ivdep
-#endif
+    DEM_IVDEP
     for (int q = 0; q < m; q++) {
         const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
         const double n0 = b->dx[q] * inv_r, n1 = b->dy[q] * inv_r, n2 = b->dz[q] * inv_r;
@@ -118,9 +124,7 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int 
     }
     /* stage 2: tangential spring rotated into the tangent plane, Coulomb cap (the force goes
      * to b->force for now) */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC ivdep
-#endif
+    DEM_IVDEP
     for (int q = 0; q < m; q++) {
         const double n0 = s->n[0][q], n1 = s->n[1][q], n2 = s->n[2][q];
         const double vt0 = s->vt[0][q], vt1 = s->vt[1][q], vt2 = s->vt[2][q];
@@ -148,9 +152,7 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int 
     /* stage 3: rolling resistance, EPSD2: elastic-plastic spring kr = kt R*^2, limit
      * mu_r R* F_n (the torque goes to b->ti for now) */
     if (!no_rolling) {
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC ivdep
-#endif
+        DEM_IVDEP
         for (int q = 0; q < m; q++) {
             const double n0 = s->n[0][q], n1 = s->n[1][q], n2 = s->n[2][q];
             const double mu_r = uniform ? u_rolling : b->rolling[q];
@@ -183,9 +185,7 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int 
         }
     }
     /* stage 4: force on i; torques on i and on j (contact_torques() of contact_law.h) */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC ivdep
-#endif
+    DEM_IVDEP
     for (int q = 0; q < m; q++) {
         const double n0 = s->n[0][q], n1 = s->n[1][q], n2 = s->n[2][q], fn = s->fn[q];
         const double ft0 = b->force[0][q], ft1 = b->force[1][q], ft2 = b->force[2][q];

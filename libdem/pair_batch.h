@@ -15,7 +15,7 @@
 
 #include "internal.h"
 
-#define DEM_PAIR_BATCH 64 /* contacts per batch: ~60 KB of arrays, in L2 */
+#define DEM_PAIR_BATCH 64 /* contacts per batch: the batch is ~27 KB */
 
 /* Intermediates the law's stages pass on (pair_batch.c). */
 typedef struct pair_batch_scratch {
