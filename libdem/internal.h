@@ -49,7 +49,15 @@ typedef struct mesh_wall {
     double centre[3];        /* rotation centre, world, m */
     double velocity[3], omega[3];
     int moving;              /* any non-zero motion or servo */
-    int binned;              /* its triangles are in the cell bins at their current place */
+    /* cell bins (mesh_bins.c): the triangles within bin_reach of each cell of the grid they
+     * were made for, with the vertices at x_binned; valid while the grid and reach are the same
+     * and no vertex has moved more than bin_margin from there */
+    int64_t *bin_start;      /* n_cells + 1, or NULL before the first binning */
+    int32_t *bin_tri;
+    int64_t bin_capacity;
+    double *x_binned;        /* 3 nv */
+    int bin_ncell[3];
+    double bin_reach, bin_margin;
     /* load control */
     int servo_on;
     dem_servo_def servo;
@@ -128,11 +136,6 @@ struct dem_domain {
     int n_meshes, cap_meshes;
     mesh_wall *meshes;
     double mesh_disp;         /* largest mesh-vertex displacement since the last build, m */
-    int64_t *tri_cell_start;  /* n_cells + 1: triangles near each cell (CSR) */
-    int32_t *tri_cell_mesh, *tri_cell_tri;
-    int64_t tri_cell_count, tri_cell_capacity;
-    int tri_cell_ncell[3];    /* the grid they were made for */
-    double tri_cell_reach;    /* and the reach (r_max + skin) */
 
     /* neighbour search */
     pair_list pairs_cur, pairs_old;

@@ -73,6 +73,9 @@ void dem_mesh_free(mesh_wall *m)
     free(m->tri_edge);
     free(m->edge_ntri);
     free(m->normal);
+    free(m->bin_start);
+    free(m->bin_tri);
+    free(m->x_binned);
     memset(m, 0, sizeof *m);
 }
 
@@ -80,9 +83,6 @@ void dem_mesh_free_all(dem_domain *d)
 {
     for (int k = 0; k < d->n_meshes; k++) dem_mesh_free(&d->meshes[k]);
     free(d->meshes);
-    free(d->tri_cell_start);
-    free(d->tri_cell_mesh);
-    free(d->tri_cell_tri);
     tri_list *tl[2] = {&d->tris_cur, &d->tris_old};
     for (int k = 0; k < 2; k++) {
         free(tl[k]->start);
@@ -353,7 +353,6 @@ dem_status dem_mesh_append(dem_domain *d, mesh_wall *m, const char *what, int *o
     }
     d->meshes[d->n_meshes] = *m;
     *out = d->n_meshes++;
-    for (int k = 0; k < d->n_meshes; k++) d->meshes[k].binned = 0; /* the bins must list it */
     d->need_rebuild = 1;
     d->forces_valid = 0;
     d->rayleigh_cache = -1.0;

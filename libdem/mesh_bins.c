@@ -1,8 +1,11 @@
-/* Mesh-triangle candidates for the Verlet scheme: triangles are binned into the particle
- * cell grid (every triangle within reach = r_max + skin of some point of a cell is listed
- * there), then each particle keeps the triangles of its own cell that lie within r + skin.
- * Bins are remade only when a mesh moved or the grid changed. Histories follow the
- * (particle, mesh, triangle) entries across builds. */
+/* Mesh-triangle candidates for the Verlet scheme: each mesh's triangles are binned into the
+ * particle cell grid (every triangle within reach = r_max + skin of some point of a cell is
+ * listed there), then each particle keeps the triangles of its own cell that lie within
+ * r + skin. A mesh's bins are remade only when the grid or the reach changed or the mesh moved
+ * farther than the margin it was binned with (none for a still mesh, a skin for a moving one):
+ * the bins only have to hold every triangle that can be within reach, so the candidates are
+ * the same whenever they are remade. Histories follow the (particle, mesh, triangle) entries
+ * across builds. */
 #include "internal.h"
 #include "triangle.h"
 #include <math.h>
@@ -35,9 +38,8 @@ static int cell_index(const dem_domain *d, double x, int a)
 }
 
 /* Visit (count or fill) the cells near triangle t of mesh m. */
-static int64_t bin_triangle(dem_domain *d, int mi, int64_t t, double reach, int fill)
+static int64_t bin_triangle(dem_domain *d, mesh_wall *m, int64_t t, double reach, int fill)
 {
-    const mesh_wall *m = &d->meshes[mi];
     const double *v[3] = {m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2]};
     int c0[3], c1[3];
     double half2 = 0.0;
@@ -58,43 +60,53 @@ static int64_t bin_triangle(dem_domain *d, int mi, int64_t t, double reach, int 
                 tri_closest_point(centre, v[0], v[1], v[2], q);
                 if (tri_dist2(centre, q) > lim * lim) continue;
                 int64_t c = ((int64_t)cz * d->ncell[1] + cy) * d->ncell[0] + cx;
-                if (fill) {
-                    int64_t slot = d->cursor[c]++;
-                    d->tri_cell_mesh[slot] = mi;
-                    d->tri_cell_tri[slot] = (int32_t)t;
-                } else {
-                    d->tri_cell_start[c + 1]++;
-                }
+                if (fill) m->bin_tri[d->cursor[c]++] = (int32_t)t;
+                else m->bin_start[c + 1]++;
                 added++;
             }
     return added;
 }
 
-static dem_status bin_triangles(dem_domain *d, double reach)
+/* Bin the triangles of m within reach + margin of each cell, at the vertices' current place. */
+static dem_status bin_mesh(dem_domain *d, mesh_wall *m, double reach, double margin)
 {
-    int64_t *st = dem_realloc_array(d->tri_cell_start, (size_t)d->n_cells + 1, sizeof *st);
-    if (!st) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
-    d->tri_cell_start = st;
+    const double r = reach + margin;
+    int64_t *st = dem_realloc_array(m->bin_start, (size_t)d->n_cells + 1, sizeof *st);
+    double *xb = m->x_binned ? m->x_binned : malloc((size_t)m->nv * 3 * sizeof(double));
+    if (st) m->bin_start = st;
+    if (xb) m->x_binned = xb;
+    if (!st || !xb) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
     memset(st, 0, (size_t)(d->n_cells + 1) * sizeof *st);
-    for (int mi = 0; mi < d->n_meshes; mi++)
-        for (int64_t t = 0; t < d->meshes[mi].nt; t++) bin_triangle(d, mi, t, reach, 0);
+    for (int64_t t = 0; t < m->nt; t++) bin_triangle(d, m, t, r, 0);
     for (int64_t c = 0; c < d->n_cells; c++) st[c + 1] += st[c];
-    int64_t total = st[d->n_cells];
-    if (total > d->tri_cell_capacity) {
-        int64_t cap = grown(total);
-        void **arr[] = {(void **)&d->tri_cell_mesh, (void **)&d->tri_cell_tri};
-        if (!dem_realloc_all(arr, 2, (size_t)cap, sizeof(int32_t)))
-            return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
-        d->tri_cell_capacity = cap;
+    const int64_t total = st[d->n_cells];
+    if (total > m->bin_capacity) {
+        int32_t *bt = dem_realloc_array(m->bin_tri, (size_t)grown(total), sizeof *bt);
+        if (!bt) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
+        m->bin_tri = bt;
+        m->bin_capacity = grown(total);
     }
     memcpy(d->cursor, st, (size_t)(d->n_cells + 1) * sizeof *st); /* the cursor holds >= n_cells + 1 */
-    for (int mi = 0; mi < d->n_meshes; mi++)
-        for (int64_t t = 0; t < d->meshes[mi].nt; t++) bin_triangle(d, mi, t, reach, 1);
-    d->tri_cell_count = total;
-    for (int a = 0; a < 3; a++) d->tri_cell_ncell[a] = d->ncell[a];
-    d->tri_cell_reach = reach;
-    for (int mi = 0; mi < d->n_meshes; mi++) d->meshes[mi].binned = 1;
+    for (int64_t t = 0; t < m->nt; t++) bin_triangle(d, m, t, r, 1);
+    memcpy(m->x_binned, m->x, (size_t)m->nv * 3 * sizeof(double));
+    for (int a = 0; a < 3; a++) m->bin_ncell[a] = d->ncell[a];
+    m->bin_reach = reach;
+    m->bin_margin = margin;
     return DEM_OK;
+}
+
+/* Whether m's bins still list every triangle within reach of each cell: same grid and reach,
+ * and no vertex farther than the margin from where it was binned (a triangle's points move
+ * no farther than its vertices). */
+static int bins_valid(const dem_domain *d, const mesh_wall *m, double reach)
+{
+    if (!m->bin_start || m->bin_reach != reach) return 0;
+    for (int a = 0; a < 3; a++)
+        if (m->bin_ncell[a] != d->ncell[a]) return 0;
+    const double margin2 = m->bin_margin * m->bin_margin;
+    for (int64_t v = 0; v < m->nv; v++)
+        if (tri_dist2(m->x + 3 * v, m->x_binned + 3 * v) > margin2) return 0;
+    return 1;
 }
 
 /* Copy entry q of the old list into entry k of the new one. */
@@ -136,11 +148,12 @@ dem_status dem_mesh_candidates(dem_domain *d)
         return DEM_OK;
     }
     const double skin = d->def.skin, reach = d->r_max + skin;
-    int stale = reach != d->tri_cell_reach;
-    for (int a = 0; a < 3; a++) stale |= d->tri_cell_ncell[a] != d->ncell[a];
-    for (int mi = 0; mi < d->n_meshes; mi++) stale |= !d->meshes[mi].binned;
-    if (stale) {
-        dem_status s = bin_triangles(d, reach);
+    for (int mi = 0; mi < d->n_meshes; mi++) {
+        mesh_wall *m = &d->meshes[mi];
+        if (bins_valid(d, m, reach)) continue;
+        /* a moving mesh is binned a skin wider, so that it is rebinned every few builds
+         * rather than at each */
+        dem_status s = bin_mesh(d, m, reach, m->moving ? skin : 0.0);
         if (s != DEM_OK) return s;
     }
     for (int mi = 0; mi < d->n_meshes; mi++)
@@ -152,24 +165,26 @@ dem_status dem_mesh_candidates(dem_domain *d)
         const double *p = d->x + 3 * i;
         const double cut = d->radius[i] + skin;
         const int64_t c = d->cell_of[i];
-        for (int64_t s = d->tri_cell_start[c]; s < d->tri_cell_start[c + 1]; s++) {
-            const mesh_wall *m = &d->meshes[d->tri_cell_mesh[s]];
-            const int32_t t = d->tri_cell_tri[s];
-            double q[3];
-            tri_closest_point(p, m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2], q);
-            if (tri_dist2(p, q) >= cut * cut) continue;
-            if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
-            tl->mesh[count] = d->tri_cell_mesh[s];
-            tl->tri[count] = t;
-            dem_tri_entry_clear(tl, count);
-            int32_t oi = d->perm[i];
-            if (oi < old_rows)
-                for (int64_t k = old->start[oi]; k < old->start[oi + 1]; k++)
-                    if (old->mesh[k] == tl->mesh[count] && old->tri[k] == t) {
-                        carry_entry(old, k, tl, count);
-                        break;
-                    }
-            count++;
+        for (int mi = 0; mi < d->n_meshes; mi++) {
+            const mesh_wall *m = &d->meshes[mi];
+            for (int64_t s = m->bin_start[c]; s < m->bin_start[c + 1]; s++) {
+                const int32_t t = m->bin_tri[s];
+                double q[3];
+                tri_closest_point(p, m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2], q);
+                if (tri_dist2(p, q) >= cut * cut) continue;
+                if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+                tl->mesh[count] = mi;
+                tl->tri[count] = t;
+                dem_tri_entry_clear(tl, count);
+                int32_t oi = d->perm[i];
+                if (oi < old_rows)
+                    for (int64_t k = old->start[oi]; k < old->start[oi + 1]; k++)
+                        if (old->mesh[k] == tl->mesh[count] && old->tri[k] == t) {
+                            carry_entry(old, k, tl, count);
+                            break;
+                        }
+                count++;
+            }
         }
         start[i + 1] = count;
     }

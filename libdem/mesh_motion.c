@@ -72,7 +72,6 @@ void dem_meshes_move(dem_domain *d, double dt)
             m->centre[a] += m->velocity[a] * dt;
         }
         dem_mesh_update_world(m);
-        m->binned = 0;
         double maxd2 = 0.0;
         for (int64_t v = 0; v < m->nv; v++) {
             double u2 = tri_dist2(m->x + 3 * v, m->x_build + 3 * v);

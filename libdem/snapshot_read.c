@@ -400,7 +400,6 @@ static dem_status rebuild_list(reader *r)
             goto out;
         }
         memcpy(m->x, m->x_build, (size_t)m->nv * 3 * sizeof(double));
-        m->binned = 0;
     }
     st = dem_neighbor_rebuild(d, NULL);
     if (st != DEM_OK) {
@@ -415,7 +414,6 @@ out:
         if (mesh_now && mesh_now[k]) {
             free(d->meshes[k].x);
             d->meshes[k].x = mesh_now[k];
-            d->meshes[k].binned = 0;
         }
     free(now);
     free(mesh_now);
