@@ -52,7 +52,7 @@ typedef struct mesh_wall {
     /* cell bins (mesh_bins.c): the triangles within bin_reach of each cell of the grid they
      * were made for, with the vertices at x_binned; valid while the grid and reach are the same
      * and no vertex has moved more than bin_margin from there */
-    int64_t *bin_start;      /* n_cells + 1, or NULL before the first binning */
+    int32_t *bin_start;      /* n_cells + 1, or NULL before the first binning */
     int32_t *bin_tri;
     int64_t bin_capacity;
     double *x_binned;        /* 3 nv */

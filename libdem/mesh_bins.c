@@ -71,22 +71,26 @@ static int64_t bin_triangle(dem_domain *d, mesh_wall *m, int64_t t, double reach
 static dem_status bin_mesh(dem_domain *d, mesh_wall *m, double reach, double margin)
 {
     const double r = reach + margin;
-    int64_t *st = dem_realloc_array(m->bin_start, (size_t)d->n_cells + 1, sizeof *st);
+    m->bin_reach = 0.0; /* not valid until done */
+    int32_t *st = dem_realloc_array(m->bin_start, (size_t)d->n_cells + 1, sizeof *st);
     double *xb = m->x_binned ? m->x_binned : malloc((size_t)m->nv * 3 * sizeof(double));
     if (st) m->bin_start = st;
     if (xb) m->x_binned = xb;
     if (!st || !xb) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
     memset(st, 0, (size_t)(d->n_cells + 1) * sizeof *st);
-    for (int64_t t = 0; t < m->nt; t++) bin_triangle(d, m, t, r, 0);
+    int64_t total = 0;
+    for (int64_t t = 0; t < m->nt; t++) total += bin_triangle(d, m, t, r, 0);
+    if (total > INT32_MAX)
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: a mesh lies in more than %d (triangle, cell) pairs; "
+                        "coarser mesh or larger particles needed", INT32_MAX);
     for (int64_t c = 0; c < d->n_cells; c++) st[c + 1] += st[c];
-    const int64_t total = st[d->n_cells];
     if (total > m->bin_capacity) {
         int32_t *bt = dem_realloc_array(m->bin_tri, (size_t)grown(total), sizeof *bt);
         if (!bt) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");
         m->bin_tri = bt;
         m->bin_capacity = grown(total);
     }
-    memcpy(d->cursor, st, (size_t)(d->n_cells + 1) * sizeof *st); /* the cursor holds >= n_cells + 1 */
+    for (int64_t c = 0; c <= d->n_cells; c++) d->cursor[c] = st[c]; /* the cursor holds >= n_cells + 1 */
     for (int64_t t = 0; t < m->nt; t++) bin_triangle(d, m, t, r, 1);
     memcpy(m->x_binned, m->x, (size_t)m->nv * 3 * sizeof(double));
     for (int a = 0; a < 3; a++) m->bin_ncell[a] = d->ncell[a];

@@ -63,11 +63,21 @@ static int wall_list_reserve(wall_list *wl, int64_t need)
     return 1;
 }
 
-/* Choose the cell grid: cells at least as large as the cut-off, at most ~2 per particle. */
+/* Cells per particle the grid may have. The grid spans the domain; where the particles fill
+ * a small part of it (a heap in a wide box, a ring in its bounding box) a tighter cap makes
+ * the cells many times the cut-off and the list build tests every pair of far larger cells
+ * (2 per particle: aor tiny's cells were 28 cut-off volumes, ~108 distance tests per particle
+ * and pass). The cost is memory in such domains: 16 bytes per cell (offsets and the sort's
+ * cursor) and 4 per cell and mesh (mesh bins), i.e. at most 128 + 32 x meshes bytes per
+ * particle. */
+#define CELLS_PER_PARTICLE 8
+
+/* Choose the cell grid: cells at least as large as the cut-off, at most ~CELLS_PER_PARTICLE
+ * per particle. */
 static dem_status choose_cells(dem_domain *d, int64_t n_live)
 {
     const double cutoff = 2.0 * d->r_max + d->def.skin;
-    int64_t limit = 2 * n_live + 1024;
+    int64_t limit = CELLS_PER_PARTICLE * n_live + 1024;
     for (int a = 0; a < 3; a++) {
         double len = d->def.hi[a] - d->def.lo[a];
         int nc = (int)floor(len / cutoff);
