@@ -6,6 +6,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #define IMAGE_NONE 13
 
@@ -126,8 +129,29 @@ static const int half_stencil[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 
                                         {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1},  {1, 0, 1},
                                         {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
 
-/* Candidate partners of particle i; with out_j == NULL only counts them. */
-static int64_t scan_row(const dem_domain *d, int64_t i, int32_t *out_j, uint8_t *out_image)
+/* One thread's candidate partners for its rows, found in one pass and then copied into the
+ * list (a counting pass first would compute every distance twice). */
+typedef struct scan_buffer {
+    int32_t *j;
+    uint8_t *image;
+    int64_t count, cap;
+    int failed; /* out of memory */
+} scan_buffer;
+
+static int scan_buffer_grow(scan_buffer *b)
+{
+    int64_t c = b->cap ? 2 * b->cap : 1024;
+    int32_t *j = dem_realloc_array(b->j, (size_t)c, sizeof *j);
+    if (j) b->j = j;
+    uint8_t *im = dem_realloc_array(b->image, (size_t)c, 1);
+    if (im) b->image = im;
+    if (!j || !im) return 0;
+    b->cap = c;
+    return 1;
+}
+
+/* Appends the candidate partners of particle i to b; returns their number (-1: out of memory). */
+static int64_t scan_row(const dem_domain *d, int64_t i, scan_buffer *b)
 {
     const double *x = d->x;
     const double skin = d->def.skin;
@@ -143,10 +167,9 @@ static int64_t scan_row(const dem_domain *d, int64_t i, int32_t *out_j, uint8_t 
         double dx = x[3 * i] - x[3 * j], dy = x[3 * i + 1] - x[3 * j + 1], dz = x[3 * i + 2] - x[3 * j + 2];
         double cut = ri + d->radius[j] + skin;
         if (dx * dx + dy * dy + dz * dz < cut * cut) {
-            if (out_j) {
-                out_j[count] = (int32_t)j;
-                out_image[count] = IMAGE_NONE;
-            }
+            if (b->count == b->cap && !scan_buffer_grow(b)) return -1;
+            b->j[b->count] = (int32_t)j;
+            b->image[b->count++] = IMAGE_NONE;
             count++;
         }
     }
@@ -176,10 +199,9 @@ static int64_t scan_row(const dem_domain *d, int64_t i, int32_t *out_j, uint8_t 
             double dz = x[3 * i + 2] - (x[3 * j + 2] + shift[2]);
             double cut = ri + d->radius[j] + skin;
             if (dx * dx + dy * dy + dz * dz < cut * cut) {
-                if (out_j) {
-                    out_j[count] = (int32_t)j;
-                    out_image[count] = image;
-                }
+                if (b->count == b->cap && !scan_buffer_grow(b)) return -1;
+                b->j[b->count] = (int32_t)j;
+                b->image[b->count++] = image;
                 count++;
             }
         }
@@ -296,27 +318,60 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;
 
-    /* pair list: count, prefix, fill */
+    /* pair list: each thread scans its rows into its buffer; prefix; copy + histories */
     int64_t *start = dem_realloc_array(pl->start, (size_t)n + 1, sizeof *start);
-    if (!start) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    scan_buffer *bufs = calloc((size_t)nt, sizeof *bufs);
+    if (!start || !bufs) {
+        free(bufs);
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    }
     pl->start = start;
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (int64_t i = 0; i < n; i++) start[i + 1] = scan_row(d, i, NULL, NULL);
-    start[0] = 0;
-    for (int64_t i = 0; i < n; i++) start[i + 1] += start[i];
-    const int64_t count = start[n];
-    if (!pair_list_reserve(pl, count))
-        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for %lld pairs", (long long)count);
-    pl->count = count;
-    pl->n_rows = n;
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (int64_t i = 0; i < n; i++) {
-        scan_row(d, i, pl->j + start[i], pl->image + start[i]);
-        for (int64_t k = start[i]; k < start[i + 1]; k++) {
-            transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl, k);
-            pl->active[k] = 1; /* reaction slot not yet written */
+    int parts = 1; /* rows [n p / parts, n (p + 1) / parts) went to buffer p */
+#pragma omp parallel num_threads(nt)
+    {
+        int tid = 0, nth = 1;
+#ifdef _OPENMP
+        tid = omp_get_thread_num();
+        nth = omp_get_num_threads();
+#endif
+        if (tid == 0) parts = nth;
+        scan_buffer *b = &bufs[tid];
+        for (int64_t i = n * tid / nth; i < n * (tid + 1) / nth && !b->failed; i++) {
+            const int64_t c = scan_row(d, i, b);
+            b->failed = c < 0;
+            start[i + 1] = c;
         }
     }
+    int64_t count = 0;
+    int ok = 1;
+    for (int p = 0; p < parts; p++) {
+        count += bufs[p].count;
+        ok &= !bufs[p].failed;
+    }
+    ok = ok && pair_list_reserve(pl, count);
+    if (ok) {
+        start[0] = 0;
+        for (int64_t i = 0; i < n; i++) start[i + 1] += start[i];
+        pl->count = count;
+        pl->n_rows = n;
+#pragma omp parallel for schedule(static, 1) num_threads(nt)
+        for (int p = 0; p < parts; p++) {
+            const int64_t k0 = start[n * p / parts];
+            memcpy(pl->j + k0, bufs[p].j, (size_t)bufs[p].count * sizeof *pl->j);
+            memcpy(pl->image + k0, bufs[p].image, (size_t)bufs[p].count);
+            for (int64_t i = n * p / parts; i < n * (p + 1) / parts; i++)
+                for (int64_t k = start[i]; k < start[i + 1]; k++) {
+                    transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl, k);
+                    pl->active[k] = 1; /* reaction slot not yet written */
+                }
+        }
+    }
+    for (int p = 0; p < nt; p++) {
+        free(bufs[p].j);
+        free(bufs[p].image);
+    }
+    free(bufs);
+    if (!ok) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the pair list");
 
     /* per-entry force scratch and the transposed list (entries where a particle is j) */
     if (refit(count, d->trans_capacity)) {
