@@ -172,9 +172,13 @@ dem_status dem_mesh_candidates(dem_domain *d)
         for (int mi = 0; mi < d->n_meshes; mi++) {
             const mesh_wall *m = &d->meshes[mi];
             for (int64_t s = m->bin_start[c]; s < m->bin_start[c + 1]; s++) {
-                const int32_t t = m->bin_tri[s];
+                const int32_t t = m->bin_tri[s], *tv = m->tri + 3 * t;
+                const double *a = m->x + 3 * tv[0], *tn = m->normal + 3 * t;
+                const double hp = (p[0] - a[0]) * tn[0] + (p[1] - a[1]) * tn[1] + (p[2] - a[2]) * tn[2];
+                if (fabs(hp) >= cut * (1.0 + 1e-9)) continue; /* farther from its plane: no need to look closer
+                                                               * (the margin covers the round-off of hp) */
                 double q[3];
-                tri_closest_point(p, m->x + 3 * m->tri[3 * t], m->x + 3 * m->tri[3 * t + 1], m->x + 3 * m->tri[3 * t + 2], q);
+                tri_closest_point(p, a, m->x + 3 * tv[1], m->x + 3 * tv[2], q);
                 if (tri_dist2(p, q) >= cut * cut) continue;
                 if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
                 tl->mesh[count] = mi;
