@@ -121,6 +121,7 @@ class AngleOfRepose:
         res.frames = [f for f in frames if f]
         res.info = {"particles": c.particles, "particles_on_base": len(d), "steps": st.steps, "dt": d.dt,
                     "simulated_time": d.time, "at_rest": bool(at_rest), "wall_seconds": st.wall_seconds(),
+                    "engine_profile": d.profile(),
                     "seed": seed, "estimator": __doc__.split("Estimator")[1].split("Bulk density")[0].strip()}
         return res
 

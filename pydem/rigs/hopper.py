@@ -221,6 +221,7 @@ class Hopper:
         res.frames = self._label_frames(frames, t_dis, fdir)
         res.info = {"particles": n_initial, "fine": n_fine, "coarse": n_coarse, "case": c.case, "packing": c.packing,
                     "steps": st.steps, "dt": d.dt, "simulated_time": d.time, "emptied": emptied,
+                    "engine_profile": d.profile(),
                     "wall_seconds": st.wall_seconds(), "seed": seed, "slot_width": c.slot_width,
                     "thickness": c.thickness}
         return res

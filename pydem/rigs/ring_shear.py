@@ -248,6 +248,7 @@ class RingShear:
         res.series = {k: np.asarray(v) for k, v in st.series.items()}
         res.frames = [f for f in frames if f]
         res.info = {"particles": c.particles, "steps": st.steps, "dt": d.dt, "simulated_time": d.time,
+                    "engine_profile": d.profile(),
                     "wall_seconds": st.wall_seconds(), "seed": seed, "phases": phase_log,
                     "shear_points": [{"fraction": f, "sigma": s, "tau_peak": t} for f, s, t in points]}
         return res
