@@ -131,6 +131,7 @@ void dem_domain_destroy(dem_domain *d)
     free(d->trans_entry);
     free(d->cell_of);
     free(d->trans_lo);
+    free(d->deferred);
     free(d->trans_hi);
     free(d->is_direct);
     free(d->cell_start);
@@ -226,7 +227,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     size_t b = sizeof *d;
     size_t cap = (size_t)d->cap;
     b += cap * (6 * 3 + 3) * sizeof(double); /* x v w f t x_build; radius inv_mass inv_inertia */
-    b += cap * (sizeof(int32_t) * 5 + sizeof(dem_particle_id) + sizeof(int64_t) + 1); /* mat cell_of perm trans_lo/hi id trans_start is_direct */
+    b += cap * (sizeof(int32_t) * 6 + sizeof(dem_particle_id) + sizeof(int64_t) + 1); /* mat cell_of perm trans_lo/hi deferred id trans_start is_direct */
     b += (size_t)(d->walls_cur.start ? 2 * (cap + 1) * sizeof(int64_t) : 0);     /* wall list offsets */
     b += (size_t)d->cap_ids * sizeof(int32_t);
     b += (size_t)d->cap_cells * sizeof(int64_t) + (size_t)d->cap_cursor * sizeof(int64_t);

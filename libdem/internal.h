@@ -107,6 +107,8 @@ typedef struct wall_list {
     double *force;        /* 3 per entry: force on the particle, last step */
 } wall_list;
 
+#define DEM_SPLIT_MAX 64 /* threads whose rows the sweep balances (more: an even split) */
+
 struct dem_domain {
     dem_domain_def def;
     char errmsg[DEM_ERRMSG_SIZE];
@@ -151,6 +153,13 @@ struct dem_domain {
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
     uint8_t *is_direct;       /* n: whether the sweep finishes the particle as it goes, set by
                                * each sweep for its thread's own rows (sweep.c) */
+    /* the sweep's rows of thread t: split[t] to split[t + 1], for split_threads threads (0: even
+     * split), moved after each sweep toward equal measured times (sweep.c); the results do not
+     * depend on the split */
+    int32_t *deferred;        /* n: thread t's deferred particles from split[t] on (sweep.c) */
+    int64_t split[DEM_SPLIT_MAX + 1];
+    double split_busy[DEM_SPLIT_MAX];
+    int split_threads;
     int64_t trans_capacity;   /* entries the slot and trans_entry arrays can hold */
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */

@@ -16,11 +16,11 @@ static int reserve_particles(dem_domain *d, int64_t need)
     void **vec3[] = {(void **)&d->x, (void **)&d->v, (void **)&d->w, (void **)&d->f, (void **)&d->t, (void **)&d->x_build};
     void **scalar[] = {(void **)&d->radius, (void **)&d->inv_mass, (void **)&d->inv_inertia};
     void **i32[] = {(void **)&d->mat, (void **)&d->cell_of, (void **)&d->perm, (void **)&d->trans_lo,
-                    (void **)&d->trans_hi};
+                    (void **)&d->trans_hi, (void **)&d->deferred};
     void **i64[] = {(void **)&d->id, (void **)&d->trans_start};
     void **u8[] = {(void **)&d->is_direct};
     if (!dem_realloc_all(vec3, 6, (size_t)c * 3, sizeof(double)) || !dem_realloc_all(scalar, 3, (size_t)c, sizeof(double)) ||
-        !dem_realloc_all(i32, 5, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(i64, 2, (size_t)c + 1, sizeof(int64_t)) ||
+        !dem_realloc_all(i32, 6, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(i64, 2, (size_t)c + 1, sizeof(int64_t)) ||
         !dem_realloc_all(u8, 1, (size_t)c, 1))
         return 0;
     d->cap = c;

@@ -14,7 +14,11 @@
  * sums) — are "deferred": finished after all rows are done, their reactions read back from the
  * per-entry slots. Either way every force is summed in the same order — reactions in list
  * order from zero, subtracted from the own-row sum (list order), then walls — whatever the
- * thread count, so results are bitwise identical for any number of threads. */
+ * thread count, so results are bitwise identical for any number of threads, and for any
+ * split of the rows among them. That freedom balances the load: the split moves after each
+ * sweep toward equal measured row times (rows with mesh walls or dense packing cost more
+ * than others), and the deferred particles — each thread's first layer — are finished by
+ * all threads in equal shares after the barrier. */
 #include "contact_law.h"
 #include "pair_batch.h"
 #include "sweep.h"
@@ -243,6 +247,48 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
     }
 }
 
+/* Make d->split fit n rows and nth threads: kept (rescaled if n changed) when it was made for
+ * nth threads, else even; split_threads = 0 where nth is beyond DEM_SPLIT_MAX. */
+static void split_prepare(dem_domain *d, int nth)
+{
+    const int64_t n = d->n;
+    if (nth < 1 || nth > DEM_SPLIT_MAX) {
+        d->split_threads = 0;
+        return;
+    }
+    if (d->split_threads != nth) {
+        for (int t = 0; t <= nth; t++) d->split[t] = n * t / nth;
+        d->split_threads = nth;
+    } else if (d->split[nth] != n) { /* particles were added or removed: same fractions */
+        const int64_t old = d->split[nth] > 0 ? d->split[nth] : 1;
+        for (int t = 1; t < nth; t++) d->split[t] = d->split[t] * n / old;
+        d->split[nth] = n;
+    }
+}
+
+/* Move the split points halfway toward where the measured row times say each thread would
+ * get an equal share (the time per row taken as even within each thread's rows). */
+static void split_rebalance(dem_domain *d, int nth)
+{
+    double cum[DEM_SPLIT_MAX + 1];
+    cum[0] = 0.0;
+    for (int t = 0; t < nth; t++) cum[t + 1] = cum[t] + (d->split_busy[t] > 1e-9 ? d->split_busy[t] : 1e-9);
+    int64_t next[DEM_SPLIT_MAX + 1];
+    next[0] = 0;
+    next[nth] = d->split[nth];
+    int j = 0;
+    for (int t = 1; t < nth; t++) {
+        const double target = cum[nth] * t / nth;
+        while (j < nth - 1 && cum[j + 1] <= target) j++;
+        const double at = (double)d->split[j] + (target - cum[j]) / (cum[j + 1] - cum[j]) * (double)(d->split[j + 1] - d->split[j]);
+        int64_t p = (int64_t)(0.5 * ((double)d->split[t] + at) + 0.5);
+        if (p < next[t - 1]) p = next[t - 1];
+        if (p > next[nth]) p = next[nth];
+        next[t] = p;
+    }
+    for (int t = 1; t < nth; t++) d->split[t] = next[t];
+}
+
 void dem_sweep_bounds(const dem_domain *d, double *lo, double *hi)
 {
     for (int a = 0; a < 3; a++) {
@@ -277,15 +323,22 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
     const int64_t n = d->n;
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_wall = INT64_MAX, bad_pair = INT64_MAX;
+    split_prepare(d, d->def.num_threads);
+    int balanced = 0;                         /* the team used d->split */
+    int64_t deferred_count[DEM_SPLIT_MAX]; /* then: each thread's deferred particles */
 #pragma omp parallel num_threads(d->def.num_threads) reduction(max : maxdisp2) \
     reduction(min : bad_nan, bad_out, bad_wall, bad_pair)
     {
         int tid = 0, nth = 1;
+        double t_start = 0.0;
 #ifdef _OPENMP
         tid = omp_get_thread_num();
         nth = omp_get_num_threads();
+        t_start = omp_get_wtime();
 #endif
-        const int64_t r0 = n * tid / nth, r1 = n * (tid + 1) / nth;
+        const int use_split = nth == d->split_threads;
+        if (tid == 0) balanced = use_split;
+        const int64_t r0 = use_split ? d->split[tid] : n * tid / nth, r1 = use_split ? d->split[tid + 1] : n * (tid + 1) / nth;
         sweep_result res;
         dem_sweep_result_init(&res);
         pair_batch b; /* ~27 KB on the thread's stack */
@@ -293,11 +346,15 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t kend = pl->start[r1];
         int64_t row = r0, k = pl->start[r0];
         double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
+        int64_t n_deferred = 0;
         for (int64_t i = r0; i < r1; i++) { /* direct particles' reaction sums start at zero */
             d->is_direct[i] = (uint8_t)direct(d, i, r0, r1);
             if (d->is_direct[i])
                 for (int a = 0; a < 3; a++) d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
+            else
+                d->deferred[r0 + n_deferred++] = (int32_t)i;
         }
+        if (use_split) deferred_count[tid] = n_deferred;
         while (row < r1) {
             const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
             gather(&c, row, k, k1, &b);
@@ -325,12 +382,31 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
             }
             k = k1;
         }
+#ifdef _OPENMP
+        if (use_split) d->split_busy[tid] = omp_get_wtime() - t_start;
+#else
+        (void)t_start;
+#endif
 #pragma omp barrier
-        for (int64_t i = r0; i < r1; i++) {
-            if (d->is_direct[i]) continue;
-            double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
-            double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
-            finish(&c, i, f, t, &res, 0);
+        /* the deferred particles (the first layer of each thread's rows: named by the rows
+         * before them) in equal shares, whichever thread's rows they are in */
+        int64_t total = n_deferred, q0 = 0, q1 = n_deferred;
+        if (use_split) {
+            total = 0;
+            for (int u = 0; u < nth; u++) total += deferred_count[u];
+            q0 = total * tid / nth;
+            q1 = total * (tid + 1) / nth;
+        }
+        int64_t base = 0;
+        for (int u = use_split ? 0 : tid, last = use_split ? nth - 1 : tid; u <= last; u++) {
+            const int64_t count = use_split ? deferred_count[u] : n_deferred, from = use_split ? d->split[u] : r0;
+            for (int64_t q = q0 > base ? q0 : base; q < q1 && q < base + count; q++) {
+                const int64_t i = d->deferred[from + q - base];
+                double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
+                double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
+                finish(&c, i, f, t, &res, 0);
+            }
+            base += count;
         }
         maxdisp2 = res.maxdisp2;
         bad_nan = res.bad_nan;
@@ -338,6 +414,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         bad_wall = res.bad_wall;
         bad_pair = res.bad_pair;
     }
+    if (balanced && d->split_threads > 1) split_rebalance(d, d->split_threads);
     sweep_result out = {maxdisp2, bad_nan, bad_out, bad_wall, bad_pair};
     return out;
 }
