@@ -357,8 +357,10 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
 #pragma omp parallel for schedule(static, 1) num_threads(nt)
         for (int p = 0; p < parts; p++) {
             const int64_t k0 = start[n * p / parts];
-            memcpy(pl->j + k0, bufs[p].j, (size_t)bufs[p].count * sizeof *pl->j);
-            memcpy(pl->image + k0, bufs[p].image, (size_t)bufs[p].count);
+            if (bufs[p].count > 0) { /* (an empty buffer was never allocated) */
+                memcpy(pl->j + k0, bufs[p].j, (size_t)bufs[p].count * sizeof *pl->j);
+                memcpy(pl->image + k0, bufs[p].image, (size_t)bufs[p].count);
+            }
             for (int64_t i = n * p / parts; i < n * (p + 1) / parts; i++)
                 for (int64_t k = start[i]; k < start[i + 1]; k++) {
                     transfer_pair_history(old, old_rows, d->perm[i], d->perm[pl->j[k]], pl, k);
