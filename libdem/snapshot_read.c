@@ -407,7 +407,9 @@ static dem_status rebuild_list(reader *r)
         goto out;
     }
     for (int64_t i = 0; i < d->n && st == DEM_OK; i++) /* the sort must have kept the stored order */
-        if (d->perm[i] != (int32_t)i) st = bad(r, "the particle order is not the one of the last list build (file edited?)");
+        if (d->perm[i] != (int32_t)i)
+            st = bad(r, "the particle order is not the one of the last list build: the file was edited, or written by "
+                        "a libdem that sorts particles differently (a bit-exact restart needs the same library)");
     memcpy(d->x, now, bytes);
 out:
     for (int k = 0; k < d->n_meshes; k++)
