@@ -240,5 +240,17 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     for (int k = 0; k < 2; k++) b += (size_t)wls[k]->capacity * (sizeof(int32_t) + 9 * sizeof(double));
     b += (size_t)d->n_materials * d->n_materials * (sizeof(pair_props) + 1);
     b += (size_t)d->cap_walls * sizeof(plane_wall);
+    const tri_list *tls[2] = {&d->tris_cur, &d->tris_old}; /* mesh walls and their candidates */
+    for (int k = 0; k < 2; k++)
+        b += (size_t)tls[k]->capacity * (2 * sizeof(int32_t) + 1 + 15 * sizeof(double)) +
+             (size_t)(tls[k]->start ? tls[k]->n_rows + 1 : 0) * sizeof(int64_t);
+    b += (size_t)d->cap_meshes * sizeof(mesh_wall);
+    for (int k = 0; k < d->n_meshes; k++) {
+        const mesh_wall *m = &d->meshes[k];
+        b += (size_t)m->nv * (m->x_binned ? 4 : 3) * 3 * sizeof(double); /* x_ref x x_build (x_binned) */
+        b += (size_t)m->nt * (6 * sizeof(int32_t) + 3 * sizeof(double)) + (size_t)m->ne * sizeof(int32_t);
+        const size_t cells = m->bin_start ? (size_t)m->bin_ncell[0] * m->bin_ncell[1] * m->bin_ncell[2] + 1 : 0;
+        b += (cells + (size_t)m->bin_capacity) * sizeof(int32_t);
+    }
     return b;
 }

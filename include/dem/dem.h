@@ -44,7 +44,7 @@ DEM_API dem_status dem_domain_profile(const dem_domain *domain, dem_profile *pro
 DEM_API dem_status dem_domain_profile_reset(dem_domain *domain);
 /* 64-bit FNV-1a hash of ids, positions, velocities, angular velocities (bitwise). */
 DEM_API dem_status dem_domain_state_hash(const dem_domain *domain, uint64_t *hash);
-/* Bytes held by the domain's arrays (particles, lists, histories). */
+/* Bytes held by the domain's arrays (particles, lists, histories, mesh walls and their bins). */
 DEM_API size_t dem_domain_memory_bytes(const dem_domain *domain);
 
 /* ---- materials and material pairs ---------------------------------------------- */

@@ -234,6 +234,27 @@ static void test_mesh_candidates_find_every_contact(void **state)
     dem_domain_destroy(d);
 }
 
+/* dem_domain_memory_bytes counts mesh walls: adding a 20,000-triangle mesh under a resting
+ * sphere grows it by at least the triangles' normals and indices (48 bytes each), far more
+ * than the sphere's lists can change. */
+static void test_memory_counts_meshes(void **state)
+{
+    (void)state;
+    int mat;
+    dem_domain *d = make_domain(0.04, 1e-6, E, 0.5, 0.3, &mat);
+    assert_non_null(d);
+    double pos[3] = {0.02, 0.02, 0.02};
+    assert_ok(dem_particles_add(d, 1, pos, (double[]){R}, &mat, NULL, NULL, NULL));
+    assert_ok(dem_domain_step(d, 1));
+    const size_t before = dem_domain_memory_bytes(d);
+    add_grid_mesh(d, 0.0, 0.04, 0.0, 0.04, 0.001, 100, 100, mat);
+    assert_ok(dem_domain_step(d, 1));
+    const size_t after = dem_domain_memory_bytes(d);
+    if (getenv("DEM_TEST_VERBOSE")) printf("  memory %zu -> %zu bytes\n", before, after);
+    assert_true(after >= before + 20000 * 48);
+    dem_domain_destroy(d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -242,6 +263,7 @@ int main(void)
         cmocka_unit_test(test_moving_mesh_belt),
         cmocka_unit_test(test_rotation_pose),
         cmocka_unit_test(test_mesh_candidates_find_every_contact),
+        cmocka_unit_test(test_memory_counts_meshes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
