@@ -174,7 +174,7 @@ dem_status dem_mesh_candidates(dem_domain *d)
             for (int64_t s = m->bin_start[c]; s < m->bin_start[c + 1]; s++) {
                 const int32_t t = m->bin_tri[s], *tv = m->tri + 3 * t;
                 const double *a = m->x + 3 * tv[0], *tn = m->normal + 3 * t;
-                const double hp = (p[0] - a[0]) * tn[0] + (p[1] - a[1]) * tn[1] + (p[2] - a[2]) * tn[2];
+                const double hp = tri_plane_height(p, a, tn);
                 if (fabs(hp) >= cut * (1.0 + 1e-9)) continue; /* farther from its plane: no need to look closer
                                                                * (the margin covers the round-off of hp) */
                 double q[3];

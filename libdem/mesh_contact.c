@@ -45,7 +45,7 @@ static int find_touching(const dem_domain *d, int64_t i, touch *tc)
         const mesh_wall *m = &d->meshes[tl->mesh[k]];
         const int32_t t = tl->tri[k], *tv = m->tri + 3 * t;
         const double *a = m->x + 3 * tv[0], *tn = m->normal + 3 * t;
-        const double hp = (p[0] - a[0]) * tn[0] + (p[1] - a[1]) * tn[1] + (p[2] - a[2]) * tn[2];
+        const double hp = tri_plane_height(p, a, tn);
         if (hp >= r || hp <= -r) continue; /* farther from the plane than r: cannot touch */
         double q[3];
         int region = tri_closest_point(p, a, m->x + 3 * tv[1], m->x + 3 * tv[2], q);

@@ -69,6 +69,13 @@ static inline int tri_closest_point(const double *p, const double *a, const doub
     return TRI_FACE;
 }
 
+/* Signed height of p above the plane through a with unit normal n: no point of a triangle
+ * in that plane is closer to p than its absolute value. */
+static inline double tri_plane_height(const double *p, const double *a, const double *n)
+{
+    return (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1] + (p[2] - a[2]) * n[2];
+}
+
 static inline double tri_dist2(const double *p, const double *q)
 {
     const double u0 = p[0] - q[0], u1 = p[1] - q[1], u2 = p[2] - q[2];
