@@ -242,7 +242,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     b += (size_t)d->cap_walls * sizeof(plane_wall);
     const tri_list *tls[2] = {&d->tris_cur, &d->tris_old}; /* mesh walls and their candidates */
     for (int k = 0; k < 2; k++)
-        b += (size_t)tls[k]->capacity * (2 * sizeof(int32_t) + 1 + 15 * sizeof(double)) +
+        b += (size_t)tls[k]->capacity * (2 * sizeof(int32_t) + 1 + 18 * sizeof(double)) +
              (size_t)(tls[k]->start ? tls[k]->n_rows + 1 : 0) * sizeof(int64_t);
     b += (size_t)d->cap_meshes * sizeof(mesh_wall);
     for (int k = 0; k < d->n_meshes; k++) {

@@ -80,6 +80,8 @@ typedef struct tri_list {
     uint8_t *active;
     double *hist;            /* 6 per entry: tangential spring (3), rolling torque (3) */
     double *force;           /* 3 per entry: force on the particle, last step */
+    double *torque;          /* 3 per entry: torque on the particle, kept only from the contact's
+                              * evaluation to the particle's finish within one sweep */
     double *point;           /* 3 per entry: contact point, last step */
     double *normal;          /* 3 per entry: contact normal (towards the particle), last step */
 } tri_list;
@@ -212,9 +214,14 @@ void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
 dem_status dem_report_runaway_pair(dem_domain *d, int64_t k);
 dem_status dem_report_runaway_wall(dem_domain *d, int64_t i);
 
-/* mesh_contact.c: mesh contacts of particle i added to f/t (*bad: i if an overlap runs away
- * or too many triangles touch, min). */
-void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
+/* mesh_contact.c: the mesh contacts of rows [i0, i1) evaluated into their entries (force,
+ * torque, springs; *bad: the first particle whose overlap runs away or that too many
+ * triangles touch), the law in batches through `scratch`; then, at the particle's finish,
+ * their sum added to its f/t. */
+struct pair_batch;
+void dem_mesh_contacts_rows(dem_domain *d, int64_t i0, int64_t i1, double dt_hist, struct pair_batch *scratch,
+                            int64_t *bad);
+void dem_mesh_contacts_add(const dem_domain *d, int64_t i, double *f, double *t);
 dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i);
 
 /* mesh_bins.c: candidate triangles of every particle (called by the neighbour build) */

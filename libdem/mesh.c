@@ -91,6 +91,7 @@ void dem_mesh_free_all(dem_domain *d)
         free(tl[k]->active);
         free(tl[k]->hist);
         free(tl[k]->force);
+        free(tl[k]->torque);
         free(tl[k]->point);
         free(tl[k]->normal);
     }

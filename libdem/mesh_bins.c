@@ -21,9 +21,9 @@ static int tri_list_reserve(tri_list *tl, int64_t need)
     void **i32[] = {(void **)&tl->mesh, (void **)&tl->tri};
     void **u8[] = {(void **)&tl->active};
     void **h6[] = {(void **)&tl->hist};
-    void **v3[] = {(void **)&tl->force, (void **)&tl->point, (void **)&tl->normal};
+    void **v3[] = {(void **)&tl->force, (void **)&tl->torque, (void **)&tl->point, (void **)&tl->normal};
     if (!dem_realloc_all(i32, 2, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(u8, 1, (size_t)c, 1) ||
-        !dem_realloc_all(h6, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(v3, 3, (size_t)c * 3, sizeof(double)))
+        !dem_realloc_all(h6, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(v3, 4, (size_t)c * 3, sizeof(double)))
         return 0;
     tl->capacity = c;
     return 1;
@@ -128,6 +128,7 @@ void dem_tri_entry_clear(tri_list *tl, int64_t k)
     tl->active[k] = 0;
     memset(tl->hist + 6 * k, 0, 6 * sizeof(double));
     memset(tl->force + 3 * k, 0, 3 * sizeof(double));
+    memset(tl->torque + 3 * k, 0, 3 * sizeof(double));
     memset(tl->point + 3 * k, 0, 3 * sizeof(double));
     memset(tl->normal + 3 * k, 0, 3 * sizeof(double));
 }

@@ -13,6 +13,7 @@
  * triangle to its neighbour (sliding across a seam), the new entry takes the history of the
  * entry that just lost its contact, if their normals agree within 60 degrees. */
 #include "contact_law.h"
+#include "pair_batch.h"
 #include "triangle.h"
 #include <math.h>
 #include <string.h>
@@ -105,7 +106,28 @@ static int is_accepted(const touch *tc, int nt, int64_t k)
     return 0;
 }
 
-void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad)
+/* The batched contacts' law, results into their entries. */
+static void flush(dem_domain *d, pair_batch *b, double dt_hist)
+{
+    if (b->m == 0) return;
+    dem_pair_batch_props(b, NULL);
+    dem_wall_batch_law(b, dt_hist);
+    tri_list *tl = &d->tris_cur;
+    for (int q = 0; q < b->m; q++) {
+        const int64_t k = b->k[q];
+        for (int a = 0; a < 3; a++) {
+            tl->hist[6 * k + a] = b->h[a][q];
+            tl->hist[6 * k + 3 + a] = b->h[3 + a][q];
+            tl->force[3 * k + a] = b->force[a][q];
+            tl->torque[3 * k + a] = b->ti[a][q];
+        }
+    }
+    b->m = 0;
+}
+
+/* Particle i's contacts: found, selected, histories handed over; each goes into the batch b
+ * (or, for a pair type the batch loop does not cover, through contact_law() at once). */
+static void particle_contacts(dem_domain *d, int64_t i, double dt_hist, pair_batch *b, int64_t *bad)
 {
     tri_list *tl = &d->tris_cur;
     const int64_t k0 = tl->start[i], k1 = tl->start[i + 1];
@@ -125,7 +147,7 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         const mesh_wall *m = &d->meshes[tl->mesh[k]];
         double n[3]; /* from the surface point to the centre */
         const double inv = tc[a].dist > 1e-12 * r ? 1.0 / tc[a].dist : 0.0;
-        for (int b = 0; b < 3; b++) n[b] = (p[b] - tc[a].q[b]) * inv;
+        for (int c = 0; c < 3; c++) n[c] = (p[c] - tc[a].q[c]) * inv;
         if (inv == 0.0) memcpy(n, m->normal + 3 * tl->tri[k], sizeof n); /* centre on the surface */
         if (!tl->active[k]) { /* new here: take over a contact that just left */
             int64_t best = -1;
@@ -148,26 +170,69 @@ void dem_mesh_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         double rel[3] = {q[0] - m->centre[0], q[1] - m->centre[1], q[2] - m->centre[2]};
         double vw[3] = {m->velocity[0] + om[1] * rel[2] - om[2] * rel[1], m->velocity[1] + om[2] * rel[0] - om[0] * rel[2],
                         m->velocity[2] + om[0] * rel[1] - om[1] * rel[0]};
-        contact_in c;
-        const double ci = wall_contact_in(&c, n, tc[a].dist, r, d->inv_mass[i], vi, wi, vw, om);
-        if (c.overlap > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
-        contact_out o;
-        contact_law(&row_pairs[m->material], &c, dt_hist, tl->hist + 6 * k, tl->hist + 6 * k + 3, &o);
-        for (int b = 0; b < 3; b++) {
-            f[b] += o.force[b];
-            t[b] += -ci * o.cross[b] + o.mr[b];
-            tl->force[3 * k + b] = o.force[b];
-            tl->point[3 * k + b] = q[b];
-            tl->normal[3 * k + b] = n[b];
+        for (int c = 0; c < 3; c++) {
+            tl->point[3 * k + c] = q[c];
+            tl->normal[3 * k + c] = n[c];
         }
         tl->active[k] = 1;
+        if (r - tc[a].dist > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
+        const pair_props *pp = &row_pairs[m->material];
+        if (dem_takes_scalar_law(pp)) {
+            contact_in c;
+            const double ci = wall_contact_in(&c, n, tc[a].dist, r, d->inv_mass[i], vi, wi, vw, om);
+            contact_out o;
+            contact_law(pp, &c, dt_hist, tl->hist + 6 * k, tl->hist + 6 * k + 3, &o);
+            for (int e = 0; e < 3; e++) {
+                tl->force[3 * k + e] = o.force[e];
+                tl->torque[3 * k + e] = -ci * o.cross[e] + o.mr[e];
+            }
+            continue;
+        }
+        if (b->m == DEM_PAIR_BATCH) flush(d, b, dt_hist);
+        const int e = b->m++;
+        b->k[e] = k;
+        b->pp[e] = pp;
+        b->dx[e] = n[0];
+        b->dy[e] = n[1];
+        b->dz[e] = n[2];
+        b->dist[e] = tc[a].dist;
+        b->ri[e] = r;
+        b->imi[e] = d->inv_mass[i];
+        for (int c = 0; c < 3; c++) {
+            b->dv[c][e] = vi[c] - vw[c];
+            b->wi[c][e] = wi[c];
+            b->wj[c][e] = om[c];
+        }
+        for (int c = 0; c < 6; c++) b->h[c][e] = tl->hist[6 * k + c];
     }
     /* entries without a contact now forget theirs */
     for (int64_t k = k0; k < k1; k++)
         if (tl->active[k] && !is_accepted(tc, nt, k)) dem_tri_entry_clear(tl, k);
 }
 
-/* Cold path: why particle i was flagged by dem_mesh_contacts. */
+void dem_mesh_contacts_rows(dem_domain *d, int64_t i0, int64_t i1, double dt_hist, pair_batch *scratch, int64_t *bad)
+{
+    const int64_t *start = d->tris_cur.start;
+    scratch->m = 0;
+    for (int64_t i = i0; i < i1; i++)
+        if (start[i] < start[i + 1]) particle_contacts(d, i, dt_hist, scratch, bad);
+    flush(d, scratch, dt_hist);
+}
+
+/* In entry order, as the contacts were once added one by one: the same sums. */
+void dem_mesh_contacts_add(const dem_domain *d, int64_t i, double *f, double *t)
+{
+    const tri_list *tl = &d->tris_cur;
+    for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) {
+        if (!tl->active[k]) continue;
+        for (int a = 0; a < 3; a++) {
+            f[a] += tl->force[3 * k + a];
+            t[a] += tl->torque[3 * k + a];
+        }
+    }
+}
+
+/* Cold path: why particle i was flagged by dem_mesh_contacts_rows. */
 dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i)
 {
     touch tc[MAX_TOUCHING];

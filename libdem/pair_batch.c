@@ -31,7 +31,7 @@ DEM_INLINE void keep_in_plane(double *x0, double *x1, double *x2, double n0, dou
     *x2 *= s;
 }
 
-static int takes_scalar_law(const pair_props *pp)
+int dem_takes_scalar_law(const pair_props *pp)
 {
     return pp->n_effects > 0 || (pp->def.rolling_model != DEM_ROLLING_EPSD2 && pp->def.rolling_friction > 0.0);
 }
@@ -47,7 +47,7 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         b->uniform = m > 0 && same ? b->pp[0] : NULL;
     }
     if (b->uniform) {
-        const uint8_t sc = (uint8_t)takes_scalar_law(b->uniform);
+        const uint8_t sc = (uint8_t)dem_takes_scalar_law(b->uniform);
         memset(b->scalar, sc, (size_t)m);
         b->any_scalar = sc;
         return;
@@ -61,7 +61,7 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         b->st_ratio[q] = pp->st_over_sn_sqrt;
         b->friction[q] = pp->def.friction;
         b->rolling[q] = pp->def.rolling_model == DEM_ROLLING_EPSD2 ? pp->def.rolling_friction : 0.0;
-        b->scalar[q] = (uint8_t)takes_scalar_law(pp);
+        b->scalar[q] = (uint8_t)dem_takes_scalar_law(pp);
         any |= b->scalar[q];
     }
     b->any_scalar = any;
@@ -79,29 +79,48 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
  * several contacts run side by side (measured on the law alone without rolling: 1.6 -> 1.8
  * instructions per cycle, -12 % cycles); the operations and their order per contact are
  * unchanged, so the results are too. */
-DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int no_rolling, const double u_e_star,
-                         const double u_g_star, const double u_damping, const double u_st_ratio,
+DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uniform, const int no_rolling,
+                         const double u_e_star, const double u_g_star, const double u_damping, const double u_st_ratio,
                          const double u_friction, const double u_rolling)
 {
     const int m = b->m;
     pair_batch_scratch *s = &b->s;
     /* stage 1: geometry (unit normal from j to i, overlap, lever arms, contact-point
      * velocity), stiffnesses, normal force (Hertz spring + restitution damper, no attraction)
-     * and tangential velocity */
+     * and tangential velocity. A wall contact's geometry is that of wall_contact_in(). */
     DEM_IVDEP
     for (int q = 0; q < m; q++) {
-        const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
-        const double n0 = b->dx[q] * inv_r, n1 = b->dy[q] * inv_r, n2 = b->dz[q] * inv_r;
-        const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
-        const double delta = rsum - r;
-        const double ci = ri - 0.5 * delta, cj = rj - 0.5 * delta;
-        const double sw0 = ci * b->wi[0][q] + cj * b->wj[0][q], sw1 = ci * b->wi[1][q] + cj * b->wj[1][q],
-                     sw2 = ci * b->wi[2][q] + cj * b->wj[2][q];
-        const double vc0 = b->dv[0][q] - (sw1 * n2 - sw2 * n1);
-        const double vc1 = b->dv[1][q] - (sw2 * n0 - sw0 * n2);
-        const double vc2 = b->dv[2][q] - (sw0 * n1 - sw1 * n0);
-        const double r_eff = ri * rj / rsum;
-        const double m_eff = 1.0 / (b->imi[q] + b->imj[q]);
+        double n0, n1, n2, delta, ci, cj, vc0, vc1, vc2, r_eff, m_eff;
+        if (wall) {
+            n0 = b->dx[q];
+            n1 = b->dy[q];
+            n2 = b->dz[q];
+            const double r = b->ri[q], *w0 = b->wi[0], *w1 = b->wi[1], *w2 = b->wi[2];
+            delta = r - b->dist[q];
+            ci = r - 0.5 * delta;
+            cj = 0.0;
+            vc0 = b->dv[0][q] - ci * (w1[q] * n2 - w2[q] * n1);
+            vc1 = b->dv[1][q] - ci * (w2[q] * n0 - w0[q] * n2);
+            vc2 = b->dv[2][q] - ci * (w0[q] * n1 - w1[q] * n0);
+            r_eff = r;
+            m_eff = 1.0 / b->imi[q];
+        } else {
+            const double r = sqrt(b->r2[q]), inv_r = 1.0 / r;
+            n0 = b->dx[q] * inv_r;
+            n1 = b->dy[q] * inv_r;
+            n2 = b->dz[q] * inv_r;
+            const double ri = b->ri[q], rj = b->rj[q], rsum = ri + rj;
+            delta = rsum - r;
+            ci = ri - 0.5 * delta;
+            cj = rj - 0.5 * delta;
+            const double sw0 = ci * b->wi[0][q] + cj * b->wj[0][q], sw1 = ci * b->wi[1][q] + cj * b->wj[1][q],
+                         sw2 = ci * b->wi[2][q] + cj * b->wj[2][q];
+            vc0 = b->dv[0][q] - (sw1 * n2 - sw2 * n1);
+            vc1 = b->dv[1][q] - (sw2 * n0 - sw0 * n2);
+            vc2 = b->dv[2][q] - (sw0 * n1 - sw1 * n0);
+            r_eff = ri * rj / rsum;
+            m_eff = 1.0 / (b->imi[q] + b->imj[q]);
+        }
         const double sqrt_rd = sqrt(r_eff * delta);
         const double sn = 2.0 * (uniform ? u_e_star : b->e_star[q]) * sqrt_rd;
         const double kn = (2.0 / 3.0) * sn;
@@ -205,16 +224,28 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int uniform, const int 
     }
 }
 
-void dem_pair_batch_law(pair_batch *b, double dt)
+/* The loop specialised for the batch's kind (pair or wall contacts) and pair constants. */
+DEM_INLINE void law_kind(pair_batch *b, double dt, const int wall)
 {
     const pair_props *u = b->uniform;
     const double u_rolling = u && u->def.rolling_model == DEM_ROLLING_EPSD2 ? u->def.rolling_friction : 0.0;
     if (u && u_rolling > 0.0)
-        law_loop(b, dt, 1, 0, u->e_star, u->g_star, u->damping_factor, u->st_over_sn_sqrt, u->def.friction, u_rolling);
+        law_loop(b, dt, wall, 1, 0, u->e_star, u->g_star, u->damping_factor, u->st_over_sn_sqrt, u->def.friction,
+                 u_rolling);
     else if (u)
-        law_loop(b, dt, 1, 1, u->e_star, u->g_star, u->damping_factor, u->st_over_sn_sqrt, u->def.friction, 0.0);
+        law_loop(b, dt, wall, 1, 1, u->e_star, u->g_star, u->damping_factor, u->st_over_sn_sqrt, u->def.friction, 0.0);
     else
-        law_loop(b, dt, 0, 0, 0, 0, 0, 0, 0, 0);
+        law_loop(b, dt, wall, 0, 0, 0, 0, 0, 0, 0, 0);
+}
+
+void dem_pair_batch_law(pair_batch *b, double dt)
+{
+    law_kind(b, dt, 0);
+}
+
+void dem_wall_batch_law(pair_batch *b, double dt)
+{
+    law_kind(b, dt, 1);
 }
 
 void dem_pair_batch_contact_in(const pair_batch *b, int q, contact_in *in, double *ci, double *cj)

@@ -28,12 +28,16 @@ typedef struct pair_batch {
     int m;                              /* contacts in the batch */
     int any_scalar;
     const pair_props *uniform;          /* every contact of this pair type: the constants below unset */
-    /* gathered: list entry, partner, geometry and kinematics (i minus j) */
+    /* gathered: list entry, partner, geometry and kinematics (i minus j). A batch of wall
+     * contacts (dem_wall_batch_law) instead holds in dx, dy, dz the unit normal (towards the
+     * sphere), in dist the centre-to-surface distance, in ri and imi the sphere's radius and
+     * inverse mass, in dv its velocity minus the surface's, in wi its angular velocity and in
+     * wj the wall's; r2, rj and imj are not read. */
     int64_t k[DEM_PAIR_BATCH];
     int32_t j[DEM_PAIR_BATCH];
     uint8_t scalar[DEM_PAIR_BATCH];     /* 1: evaluate with contact_law() */
     const pair_props *pp[DEM_PAIR_BATCH]; /* unset when `uniform` came from the caller */
-    double dx[DEM_PAIR_BATCH], dy[DEM_PAIR_BATCH], dz[DEM_PAIR_BATCH], r2[DEM_PAIR_BATCH];
+    double dx[DEM_PAIR_BATCH], dy[DEM_PAIR_BATCH], dz[DEM_PAIR_BATCH], r2[DEM_PAIR_BATCH], dist[DEM_PAIR_BATCH];
     double ri[DEM_PAIR_BATCH], rj[DEM_PAIR_BATCH], imi[DEM_PAIR_BATCH], imj[DEM_PAIR_BATCH];
     double dv[3][DEM_PAIR_BATCH], wi[3][DEM_PAIR_BATCH], wj[3][DEM_PAIR_BATCH];
     double h[6][DEM_PAIR_BATCH];        /* spring histories in (xi 3, rolling torque 3), updated in place */
@@ -53,6 +57,15 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all);
 
 /* The contact law of every non-scalar contact of the batch (dt: spring history increment). */
 void dem_pair_batch_law(pair_batch *b, double dt);
+
+/* The same for a batch of sphere–wall contacts (the fields as described above): bitwise the
+ * results of wall_contact_in() and contact_law(); the torque on the sphere goes to ti. The
+ * caller sends contacts that take the scalar law through contact_law() instead. */
+void dem_wall_batch_law(pair_batch *b, double dt);
+
+/* Whether contacts of this pair type need contact_law() itself (effects, or rolling models
+ * the batch loop does not cover). */
+int dem_takes_scalar_law(const pair_props *pp);
 
 /* The contact law of the scalar-flagged contacts, through contact_law(), from the histories
  * in the pair list (list_hist: 6 per entry, not yet updated); results replace the batch's. */

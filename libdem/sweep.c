@@ -28,6 +28,11 @@
 #include <omp.h>
 #endif
 
+/* Rows whose mesh contacts are evaluated together (before the first of them is finished: a
+ * particle's position and velocities do not change before its finish, nor the meshes in a
+ * sweep); enough contacts to fill the batches in the rigs. */
+#define MESH_ROWS 64
+
 typedef struct sweep_ctx {
     dem_domain *d;
     double dt_hist;   /* spring history increment (0: refresh without motion) */
@@ -225,7 +230,7 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
         t[a] += r[3 + a];
     }
     if (d->walls_cur.start[p] < d->walls_cur.start[p + 1]) dem_wall_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
-    if (d->tris_cur.start[p] < d->tris_cur.start[p + 1]) dem_mesh_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
+    if (d->tris_cur.start[p] < d->tris_cur.start[p + 1]) dem_mesh_contacts_add(d, p, f, t);
     double *fp = d->f + 3 * p, *tp = d->t + 3 * p;
     for (int a = 0; a < 3; a++) {
         fp[a] = f[a];
@@ -342,6 +347,9 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         sweep_result res;
         dem_sweep_result_init(&res);
         pair_batch b; /* ~27 KB on the thread's stack */
+        pair_batch mesh_batch; /* as much again, for the mesh contacts */
+        const int any_mesh = d->tris_cur.count > 0;
+        int64_t mesh_done = r0; /* rows before this have their mesh contacts evaluated */
         pair_list *pl = &d->pairs_cur;
         const int64_t kend = pl->start[r1];
         int64_t row = r0, k = pl->start[r0];
@@ -366,6 +374,10 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                 const int64_t row_end = pl->start[row + 1];
                 for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair, r0, r1);
                 if (row_end > k1) break; /* the row goes on in the next batch */
+                if (any_mesh && row >= mesh_done) { /* the next block's mesh contacts, batched */
+                    mesh_done = r1 - row > MESH_ROWS ? row + MESH_ROWS : r1;
+                    dem_mesh_contacts_rows(d, row, mesh_done, dt_hist, &mesh_batch, &res.bad_wall);
+                }
                 double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
                 /* direct: finish now; else park the row sums in the force arrays and finish
                  * after the barrier */

@@ -4,7 +4,8 @@
  * bit-identical forces, torques, overlaps and updated histories. Tolerance zero: the batch loop is the same sequence
  * of IEEE operations, and the engine's results (and the published benchmarks) rely on it.
  * Pairs the loop does not cover (CDT and EPSD rolling) go through contact_law() and must match
- * too. */
+ * too. The wall form of the loop (mesh contacts) must match wall_contact_in() + contact_law()
+ * the same way. */
 #include "test_util.h"
 #include "contact_law.h"
 #include "pair_batch.h"
@@ -154,11 +155,78 @@ static void test_other_rolling_models_take_the_scalar_law(void **state)
     assert_true(slides > 20 && limits > 20);
 }
 
+/* Wall contacts: a sphere against a moving, turning surface, as dem_mesh_contacts_rows batches
+ * them, against the scalar law it replaced. */
+static void check_wall_batch(const pair_props *types, int n_types, int m, int *slides)
+{
+    static pair_batch b;
+    static double h0[DEM_PAIR_BATCH][6], v[DEM_PAIR_BATCH][3], vw[DEM_PAIR_BATCH][3];
+    const double dt = 1e-6;
+    memset(&b, 0, sizeof b);
+    b.m = m;
+    for (int q = 0; q < m; q++) {
+        random_contact(&b, q, &types[q % n_types], h0[q]);
+        const double r = b.ri[q], len = sqrt(b.r2[q]);
+        b.dx[q] /= len; /* the unit normal */
+        b.dy[q] /= len;
+        b.dz[q] /= len;
+        b.dist[q] = r * (1.0 - uniform(1e-5, 0.02));
+        for (int a = 0; a < 3; a++) {
+            v[q][a] = uniform(-0.2, 0.2);
+            vw[q][a] = uniform(-0.1, 0.1);
+            b.dv[a][q] = v[q][a] - vw[q][a];
+            b.wj[a][q] = uniform(-10, 10); /* the wall's spin */
+        }
+    }
+    dem_pair_batch_props(&b, NULL);
+    assert_int_equal(b.any_scalar, 0);
+    dem_wall_batch_law(&b, dt);
+    for (int q = 0; q < m; q++) {
+        const double n[3] = {b.dx[q], b.dy[q], b.dz[q]}, w[3] = {b.wi[0][q], b.wi[1][q], b.wi[2][q]},
+                     ww[3] = {b.wj[0][q], b.wj[1][q], b.wj[2][q]};
+        contact_in c;
+        const double ci = wall_contact_in(&c, n, b.dist[q], b.ri[q], b.imi[q], v[q], w, vw[q], ww);
+        double h[6], want[12], got[12];
+        memcpy(h, h0[q], sizeof h);
+        contact_out o;
+        contact_law(b.pp[q], &c, dt, h, h + 3, &o);
+        for (int a = 0; a < 3; a++) {
+            want[a] = o.force[a];
+            want[3 + a] = -ci * o.cross[a] + o.mr[a];
+            got[a] = b.force[a][q];
+            got[3 + a] = b.ti[a][q];
+        }
+        for (int a = 0; a < 6; a++) {
+            want[6 + a] = h[a];
+            got[6 + a] = b.h[a][q];
+        }
+        for (int k = 0; k < 12; k++)
+            if (memcmp(&want[k], &got[k], sizeof(double)) != 0)
+                fail_msg("wall contact %d, value %d: batch %.17g, scalar law %.17g", q, k, got[k], want[k]);
+        const double fn = want[0] * n[0] + want[1] * n[1] + want[2] * n[2];
+        const double ft[3] = {want[0] - fn * n[0], want[1] - fn * n[1], want[2] - fn * n[2]};
+        if (fn > 0 && fabs(sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]) - types[q % n_types].def.friction * fn) <= 1e-9 * fn)
+            (*slides)++;
+    }
+}
+
+static void test_wall_batch_equals_scalar_law(void **state)
+{
+    (void)state;
+    const pair_props types[3] = {props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6),
+                                 props(0.8, 0.05, DEM_ROLLING_EPSD2, 1e8)};
+    int slides = 0;
+    for (int round = 0; round < 30; round++) check_wall_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides);
+    for (int round = 0; round < 30; round++) check_wall_batch(types + round % 3, 1, DEM_PAIR_BATCH, &slides);
+    assert_true(slides > 50);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_batch_equals_scalar_law),
         cmocka_unit_test(test_other_rolling_models_take_the_scalar_law),
+        cmocka_unit_test(test_wall_batch_equals_scalar_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
