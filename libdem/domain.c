@@ -1,5 +1,5 @@
 /* Domain life cycle, settings, profile, state hash and memory accounting. */
-#include "internal.h"
+#include "pair_batch.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -244,7 +244,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     for (int k = 0; k < 2; k++)
         b += (size_t)tls[k]->capacity * (2 * sizeof(int32_t) + 1 + 18 * sizeof(double)) +
              (size_t)(tls[k]->start ? tls[k]->n_rows + 1 : 0) * sizeof(int64_t);
-    b += (size_t)d->cap_meshes * sizeof(mesh_wall);
+    b += (size_t)d->cap_meshes * sizeof(mesh_wall) + (size_t)d->mesh_scratch_threads * sizeof(pair_batch);
     for (int k = 0; k < d->n_meshes; k++) {
         const mesh_wall *m = &d->meshes[k];
         b += (size_t)m->nv * (m->x_binned ? 4 : 3) * 3 * sizeof(double); /* x_ref x x_build (x_binned) */

@@ -140,6 +140,9 @@ struct dem_domain {
     int n_meshes, cap_meshes;
     mesh_wall *meshes;
     double mesh_disp;         /* largest mesh-vertex displacement since the last build, m */
+    void *mesh_scratch;       /* mesh_scratch_threads pair batches: each sweep thread's for its
+                               * mesh contacts (mesh_contact.c) */
+    int mesh_scratch_threads;
 
     /* neighbour search */
     pair_list pairs_cur, pairs_old;
@@ -222,6 +225,8 @@ struct pair_batch;
 void dem_mesh_contacts_rows(dem_domain *d, int64_t i0, int64_t i1, double dt_hist, struct pair_batch *scratch,
                             int64_t *bad);
 void dem_mesh_contacts_add(const dem_domain *d, int64_t i, double *f, double *t);
+/* a scratch batch per sweep thread where there are mesh walls (0: out of memory) */
+int dem_mesh_scratch_reserve(dem_domain *d);
 dem_status dem_report_runaway_mesh(dem_domain *d, int64_t i);
 
 /* mesh_bins.c: candidate triangles of every particle (called by the neighbour build) */

@@ -83,6 +83,7 @@ void dem_mesh_free_all(dem_domain *d)
 {
     for (int k = 0; k < d->n_meshes; k++) dem_mesh_free(&d->meshes[k]);
     free(d->meshes);
+    free(d->mesh_scratch);
     tri_list *tl[2] = {&d->tris_cur, &d->tris_old};
     for (int k = 0; k < 2; k++) {
         free(tl[k]->start);

@@ -16,6 +16,7 @@
 #include "pair_batch.h"
 #include "triangle.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define MAX_TOUCHING 64
@@ -217,6 +218,17 @@ void dem_mesh_contacts_rows(dem_domain *d, int64_t i0, int64_t i1, double dt_his
     for (int64_t i = i0; i < i1; i++)
         if (start[i] < start[i + 1]) particle_contacts(d, i, dt_hist, scratch, bad);
     flush(d, scratch, dt_hist);
+}
+
+int dem_mesh_scratch_reserve(dem_domain *d)
+{
+    const int need = d->n_meshes > 0 ? d->def.num_threads : 0;
+    if (need <= d->mesh_scratch_threads) return 1;
+    void *p = realloc(d->mesh_scratch, (size_t)need * sizeof(pair_batch));
+    if (!p) return 0;
+    d->mesh_scratch = p;
+    d->mesh_scratch_threads = need;
+    return 1;
 }
 
 /* In entry order, as the contacts were once added one by one: the same sums. */

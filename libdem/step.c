@@ -148,6 +148,8 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
                  100.0 * dt / tr, tr);
         result = DEM_WARN_TIMESTEP_LARGE;
     }
+    if (!dem_mesh_scratch_reserve(d))
+        return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_domain_step: out of memory (mesh contact batches)");
     if (d->need_rebuild || !d->forces_valid) {
         double t0 = now_s();
         dem_status s = refresh_forces(d);
