@@ -46,9 +46,9 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         for (int q = 1; q < m; q++) same &= b->pp[q] == b->pp[0];
         b->uniform = m > 0 && same ? b->pp[0] : NULL;
     }
-    if (b->uniform) {
+    if (b->uniform) { /* the flags are read only where any_scalar is set */
         const uint8_t sc = (uint8_t)dem_takes_scalar_law(b->uniform);
-        memset(b->scalar, sc, (size_t)m);
+        if (sc) memset(b->scalar, 1, (size_t)m);
         b->any_scalar = sc;
         return;
     }

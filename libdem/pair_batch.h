@@ -35,7 +35,7 @@ typedef struct pair_batch {
      * wj the wall's; r2, rj and imj are not read. */
     int64_t k[DEM_PAIR_BATCH];
     int32_t j[DEM_PAIR_BATCH];
-    uint8_t scalar[DEM_PAIR_BATCH];     /* 1: evaluate with contact_law() */
+    uint8_t scalar[DEM_PAIR_BATCH];     /* 1: evaluate with contact_law() (set only where any_scalar) */
     const pair_props *pp[DEM_PAIR_BATCH]; /* unset when `uniform` came from the caller */
     double dx[DEM_PAIR_BATCH], dy[DEM_PAIR_BATCH], dz[DEM_PAIR_BATCH], r2[DEM_PAIR_BATCH], dist[DEM_PAIR_BATCH];
     double ri[DEM_PAIR_BATCH], rj[DEM_PAIR_BATCH], imi[DEM_PAIR_BATCH], imj[DEM_PAIR_BATCH];

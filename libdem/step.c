@@ -92,8 +92,8 @@ static dem_status refresh_forces(dem_domain *d)
  * sweep that closes the previous one). */
 static sweep_result open_first_step(dem_domain *d)
 {
-    double lo[3], hi[3];
-    dem_sweep_bounds(d, lo, hi);
+    sweep_view view;
+    dem_sweep_view(d, &view);
     const int64_t n = d->n;
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
@@ -104,7 +104,7 @@ static sweep_result open_first_step(dem_domain *d)
         dem_sweep_result_init(&res);
         double *v = d->v + 3 * i, *w = d->w + 3 * i;
         double vl[3] = {v[0], v[1], v[2]}, wl[3] = {w[0], w[1], w[2]};
-        dem_open_step(d, i, d->f + 3 * i, d->t + 3 * i, vl, wl, lo, hi, &res);
+        dem_open_step(&view, i, d->f + 3 * i, d->t + 3 * i, vl, wl, &res);
         for (int a = 0; a < 3; a++) {
             v[a] = vl[a];
             w[a] = wl[a];

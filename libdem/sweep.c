@@ -33,15 +33,22 @@
  * sweep); enough contacts to fill the batches in the rigs. */
 #define MESH_ROWS 64
 
+/* The sweep's context; each thread works from its own copy (see sweep_view in sweep.h). */
 typedef struct sweep_ctx {
     dem_domain *d;
+    sweep_view s;
+    double *hist;     /* the pair list's springs and activity flags */
+    uint8_t *active;
+    uint8_t *is_direct;
+    const int64_t *wall_start, *tri_start; /* the plane-wall and mesh contact lists' rows */
+    const int64_t *trans_start;
+    const int32_t *trans_entry;
     double dt_hist;   /* spring history increment (0: refresh without motion) */
     sweep_mode mode;
     int all_slots;    /* write every touching entry's slot (else only those a deferred finish reads) */
     double shift[27][3];
     int periodic;     /* any periodic axis: partners may be images */
     const pair_props *all_pairs; /* the pair type of every contact (one particle material), or NULL */
-    double lo[3], hi[3]; /* closed-axis bounds (+-DBL_MAX on periodic axes) */
 } sweep_ctx;
 
 /* Gathers the contacts among list entries [k0, k1) (the first in row `row`) into the batch;
@@ -131,40 +138,34 @@ static inline int direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
     return p >= r0 && p < r1 && d->trans_lo[p] >= r0 && d->trans_hi[p] < p;
 }
 
-static inline int partner_direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
-{
-    return p >= r0 && p < r1 && d->is_direct[p];
-}
-
 /* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
  * torque on i added to the row sums acc (force 3, torque 3), the reaction to a direct
  * partner's sum. */
 static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair, int64_t r0,
                            int64_t r1)
 {
-    dem_domain *d = c->d;
-    pair_list *pl = &d->pairs_cur;
+    const sweep_view *s = &c->s;
     const int64_t k = b->k[q];
     const double ri = b->ri[q], rj = b->rj[q];
-    if (b->overlap[q] > d->def.max_overlap_ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
-    double *h = pl->hist + 6 * k;
+    if (b->overlap[q] > s->max_overlap_ratio * (ri < rj ? ri : rj) && k < *bad_pair) *bad_pair = k;
+    double *h = c->hist + 6 * k;
     for (int a = 0; a < 6; a++) h[a] = b->h[a][q];
-    pl->active[k] = 1;
+    c->active[k] = 1;
     for (int a = 0; a < 3; a++) {
         acc[a] += b->force[a][q];
         acc[3 + a] += b->ti[a][q];
     }
     const int32_t j = b->j[q];
-    const int j_direct = partner_direct(d, j, r0, r1);
+    const int j_direct = j >= r0 && j < r1 && c->is_direct[j];
     if (j_direct) {
-        double *fj = d->f + 3 * (int64_t)j, *tj = d->t + 3 * (int64_t)j;
+        double *fj = s->f + 3 * (int64_t)j, *tj = s->t + 3 * (int64_t)j;
         for (int a = 0; a < 3; a++) {
             fj[a] += b->force[a][q];
             tj[a] += b->tj[a][q];
         }
     }
     if (!j_direct || c->all_slots) {
-        double *sl = d->slot + 6 * k;
+        double *sl = s->slot + 6 * k;
         for (int a = 0; a < 3; a++) {
             sl[a] = b->force[a][q];
             sl[3 + a] = b->tj[a][q];
@@ -174,13 +175,13 @@ static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, doubl
 
 /* Opening half kick and drift of particle p (inlined into the sweep; dem_open_step() for the
  * first step of a call). */
-static inline void open_step(dem_domain *d, int64_t p, const double *f, const double *t, double *vl, double *wl,
-                             const double *lo, const double *hi, sweep_result *res)
+static inline void open_step(const sweep_view *s, int64_t p, const double *f, const double *t, double *vl, double *wl,
+                             sweep_result *res)
 {
-    const double dt = d->def.dt, half = 0.5 * dt, *g = d->def.gravity;
-    const double imp = d->inv_mass[p], iip = d->inv_inertia[p];
-    double *xp = d->x + 3 * p;
-    const double *xb = d->x_build + 3 * p;
+    const double dt = s->dt, half = s->half, *g = s->gravity, *lo = s->lo, *hi = s->hi;
+    const double imp = s->inv_mass[p], iip = s->inv_inertia[p];
+    double *xp = s->x + 3 * p;
+    const double *xb = s->x_build + 3 * p;
     double disp2 = 0.0, sum = 0.0;
     int in = 1;
     for (int a = 0; a < 3; a++) {
@@ -200,10 +201,10 @@ static inline void open_step(dem_domain *d, int64_t p, const double *f, const do
     }
 }
 
-void dem_open_step(dem_domain *d, int64_t p, const double *f, const double *t, double *vl, double *wl,
-                   const double *lo, const double *hi, sweep_result *res)
+void dem_open_step(const sweep_view *s, int64_t p, const double *f, const double *t, double *vl, double *wl,
+                   sweep_result *res)
 {
-    open_step(d, p, f, t, vl, wl, lo, hi, res);
+    open_step(s, p, f, t, vl, wl, res);
 }
 
 /* Finish particle p: add its reactions (summed in list order: as summed during the sweep if
@@ -211,17 +212,17 @@ void dem_open_step(dem_domain *d, int64_t p, const double *f, const double *t, d
  * the kicks and drift the mode asks for. */
 static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, sweep_result *res, int is_direct)
 {
-    dem_domain *d = c->d;
+    const sweep_view *s = &c->s;
     double r[6] = {0, 0, 0, 0, 0, 0};
     if (is_direct) {
         for (int a = 0; a < 3; a++) {
-            r[a] = d->f[3 * p + a];
-            r[3 + a] = d->t[3 * p + a];
+            r[a] = s->f[3 * p + a];
+            r[3 + a] = s->t[3 * p + a];
         }
     } else {
-        const int32_t *te = d->trans_entry;
-        for (int64_t q = d->trans_start[p]; q < d->trans_start[p + 1]; q++) {
-            const double *sl = d->slot + 6 * (int64_t)te[q];
+        const int32_t *te = c->trans_entry;
+        for (int64_t q = c->trans_start[p]; q < c->trans_start[p + 1]; q++) {
+            const double *sl = s->slot + 6 * (int64_t)te[q];
             for (int a = 0; a < 6; a++) r[a] += sl[a];
         }
     }
@@ -229,23 +230,23 @@ static inline void finish(const sweep_ctx *c, int64_t p, double *f, double *t, s
         f[a] -= r[a];
         t[a] += r[3 + a];
     }
-    if (d->walls_cur.start[p] < d->walls_cur.start[p + 1]) dem_wall_contacts(d, p, c->dt_hist, f, t, &res->bad_wall);
-    if (d->tris_cur.start[p] < d->tris_cur.start[p + 1]) dem_mesh_contacts_add(d, p, f, t);
-    double *fp = d->f + 3 * p, *tp = d->t + 3 * p;
+    if (c->wall_start[p] < c->wall_start[p + 1]) dem_wall_contacts(c->d, p, c->dt_hist, f, t, &res->bad_wall);
+    if (c->tri_start[p] < c->tri_start[p + 1]) dem_mesh_contacts_add(c->d, p, f, t);
+    double *fp = s->f + 3 * p, *tp = s->t + 3 * p;
     for (int a = 0; a < 3; a++) {
         fp[a] = f[a];
         tp[a] = t[a];
     }
     if (c->mode == SWEEP_FORCES) return;
-    const double half = 0.5 * d->def.dt, *g = d->def.gravity;
-    const double imp = d->inv_mass[p], iip = d->inv_inertia[p];
-    double *vp = d->v + 3 * p, *wp = d->w + 3 * p;
+    const double half = s->half, *g = s->gravity;
+    const double imp = s->inv_mass[p], iip = s->inv_inertia[p];
+    double *vp = s->v + 3 * p, *wp = s->w + 3 * p;
     double vl[3], wl[3];
     for (int a = 0; a < 3; a++) { /* closing half kick */
         vl[a] = vp[a] + half * (f[a] * imp + g[a]);
         wl[a] = wp[a] + half * t[a] * iip;
     }
-    if (c->mode == SWEEP_CLOSE_OPEN) open_step(d, p, f, t, vl, wl, c->lo, c->hi, res);
+    if (c->mode == SWEEP_CLOSE_OPEN) open_step(s, p, f, t, vl, wl, res);
     for (int a = 0; a < 3; a++) {
         vp[a] = vl[a];
         wp[a] = wl[a];
@@ -294,11 +295,24 @@ static void split_rebalance(dem_domain *d, int nth)
     for (int t = 1; t < nth; t++) d->split[t] = next[t];
 }
 
-void dem_sweep_bounds(const dem_domain *d, double *lo, double *hi)
+void dem_sweep_view(dem_domain *d, sweep_view *s)
 {
+    s->x = d->x;
+    s->v = d->v;
+    s->w = d->w;
+    s->f = d->f;
+    s->t = d->t;
+    s->slot = d->slot;
+    s->x_build = d->x_build;
+    s->inv_mass = d->inv_mass;
+    s->inv_inertia = d->inv_inertia;
+    s->dt = d->def.dt;
+    s->half = 0.5 * d->def.dt;
+    s->max_overlap_ratio = d->def.max_overlap_ratio;
     for (int a = 0; a < 3; a++) {
-        lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
-        hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
+        s->gravity[a] = d->def.gravity[a];
+        s->lo[a] = d->def.periodic[a] ? -DBL_MAX : d->def.lo[a];
+        s->hi[a] = d->def.periodic[a] ? DBL_MAX : d->def.hi[a];
     }
 }
 
@@ -320,7 +334,14 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
     c.all_slots = mode != SWEEP_CLOSE_OPEN;
     for (int s = 0; s < 27; s++)
         for (int a = 0; a < 3; a++) c.shift[s][a] = dem_image_sign[s][a] * (d->def.hi[a] - d->def.lo[a]);
-    dem_sweep_bounds(d, c.lo, c.hi);
+    dem_sweep_view(d, &c.s);
+    c.hist = d->pairs_cur.hist;
+    c.active = d->pairs_cur.active;
+    c.is_direct = d->is_direct;
+    c.wall_start = d->walls_cur.start;
+    c.tri_start = d->tris_cur.start;
+    c.trans_start = d->trans_start;
+    c.trans_entry = d->trans_entry;
     c.periodic = d->def.periodic[0] || d->def.periodic[1] || d->def.periodic[2];
     /* one particle material (the usual case): one pair type, known without looking */
     const int32_t one = d->single_material;
@@ -341,6 +362,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         nth = omp_get_num_threads();
         t_start = omp_get_wtime();
 #endif
+        const sweep_ctx ctx = c; /* the thread's own copy: see sweep_view in sweep.h */
         const int use_split = nth == d->split_threads;
         if (tid == 0) balanced = use_split;
         const int64_t r0 = use_split ? d->split[tid] : n * tid / nth, r1 = use_split ? d->split[tid + 1] : n * (tid + 1) / nth;
@@ -352,9 +374,9 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int any_mesh = d->tris_cur.count > 0;
         pair_batch *mesh_batch = any_mesh ? (pair_batch *)d->mesh_scratch + tid : NULL;
         int64_t mesh_done = r0; /* rows before this have their mesh contacts evaluated */
-        pair_list *pl = &d->pairs_cur;
-        const int64_t kend = pl->start[r1];
-        int64_t row = r0, k = pl->start[r0];
+        const int64_t *start = d->pairs_cur.start;
+        const int64_t kend = start[r1];
+        int64_t row = r0, k = start[r0];
         double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
         int64_t n_deferred = 0;
         for (int64_t i = r0; i < r1; i++) { /* direct particles' reaction sums start at zero */
@@ -367,14 +389,14 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         if (use_split) deferred_count[tid] = n_deferred;
         while (row < r1) {
             const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
-            gather(&c, row, k, k1, &b);
+            gather(&ctx, row, k, k1, &b);
             dem_pair_batch_law(&b, dt_hist);
-            if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, pl->hist);
+            if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx.hist);
             /* in list order; each row whose entries are all done is finished (or parked) */
             int q = 0;
             for (;;) {
-                const int64_t row_end = pl->start[row + 1];
-                for (; q < b.m && b.k[q] < row_end; q++) scatter(&c, &b, q, acc, &res.bad_pair, r0, r1);
+                const int64_t row_end = start[row + 1];
+                for (; q < b.m && b.k[q] < row_end; q++) scatter(&ctx, &b, q, acc, &res.bad_pair, r0, r1);
                 if (row_end > k1) break; /* the row goes on in the next batch */
                 if (any_mesh && row >= mesh_done) { /* the next block's mesh contacts, batched */
                     mesh_done = r1 - row > MESH_ROWS ? row + MESH_ROWS : r1;
@@ -383,12 +405,12 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                 double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
                 /* direct: finish now; else park the row sums in the force arrays and finish
                  * after the barrier */
-                if (d->is_direct[row]) {
-                    finish(&c, row, f, t, &res, 1);
+                if (ctx.is_direct[row]) {
+                    finish(&ctx, row, f, t, &res, 1);
                 } else {
                     for (int a = 0; a < 3; a++) {
-                        d->f[3 * row + a] = f[a];
-                        d->t[3 * row + a] = t[a];
+                        ctx.s.f[3 * row + a] = f[a];
+                        ctx.s.t[3 * row + a] = t[a];
                     }
                 }
                 for (int a = 0; a < 6; a++) acc[a] = 0.0;
@@ -418,7 +440,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                 const int64_t i = d->deferred[from + q - base];
                 double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
                 double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
-                finish(&c, i, f, t, &res, 0);
+                finish(&ctx, i, f, t, &res, 0);
             }
             base += count;
         }
