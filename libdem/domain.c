@@ -129,6 +129,7 @@ void dem_domain_destroy(dem_domain *d)
     free(d->slot);
     free(d->trans_start);
     free(d->trans_entry);
+    free(d->entry_row);
     free(d->cell_of);
     free(d->trans_lo);
     free(d->deferred);
@@ -235,7 +236,7 @@ size_t dem_domain_memory_bytes(const dem_domain *d)
     for (int k = 0; k < 2; k++)
         b += (size_t)pls[k]->capacity * (sizeof(int32_t) + 2 + 6 * sizeof(double)) +
              (size_t)(pls[k]->n_rows + 1) * sizeof(int64_t);
-    b += (size_t)d->trans_capacity * (6 * sizeof(double) + sizeof(int32_t));
+    b += (size_t)d->trans_capacity * (6 * sizeof(double) + 2 * sizeof(int32_t)); /* slot trans_entry entry_row */
     const wall_list *wls[2] = {&d->walls_cur, &d->walls_old};
     for (int k = 0; k < 2; k++) b += (size_t)wls[k]->capacity * (sizeof(int32_t) + 9 * sizeof(double));
     b += (size_t)d->n_materials * d->n_materials * (sizeof(pair_props) + 1);

@@ -155,6 +155,7 @@ struct dem_domain {
                                * finished from its slots (deferred, sweep.c) */
     int64_t *trans_start;     /* n + 1: entries where particle is the partner, list order */
     int32_t *trans_entry;
+    int32_t *entry_row;       /* per pair entry: its row (the sweep's gather runs over entries) */
     int32_t *trans_lo, *trans_hi; /* n: first and last row naming the particle as partner */
     uint8_t *is_direct;       /* n: whether the sweep finishes the particle as it goes, set by
                                * each sweep for its thread's own rows (sweep.c) */

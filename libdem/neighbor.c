@@ -379,9 +379,9 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     if (refit(count, d->trans_capacity)) {
         int64_t c = margin(count);
         void **slots[] = {(void **)&d->slot};
-        void **te[] = {(void **)&d->trans_entry};
+        void **te[] = {(void **)&d->trans_entry, (void **)&d->entry_row};
         const int ok = dem_realloc_all(slots, 1, (size_t)c * 6, sizeof(double)) &
-                       dem_realloc_all(te, 1, (size_t)c, sizeof(int32_t));
+                       dem_realloc_all(te, 2, (size_t)c, sizeof(int32_t));
         if (!ok && c > d->trans_capacity) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
         d->trans_capacity = c;
     }
@@ -403,6 +403,7 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n; i++) /* which rows name each particle: the sweep's finishing order */
         for (int64_t k = start[i]; k < start[i + 1]; k++) {
             int32_t j = pl->j[k];
+            d->entry_row[k] = (int32_t)i;
             if (i < d->trans_lo[j]) d->trans_lo[j] = (int32_t)i;
             if (i > d->trans_hi[j]) d->trans_hi[j] = (int32_t)i;
         }

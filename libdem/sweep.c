@@ -55,7 +55,9 @@ typedef struct sweep_ctx {
  * an entry whose spheres no longer touch forgets its springs and clears its slot once.
  * Two passes: the distance test writes every entry's geometry at the next free batch place
  * and advances it only for touching pairs (branch-free: whether a pair touches is a coin
- * toss the branch predictor loses), then the touching ones get the rest of their data. */
+ * toss the branch predictor loses), then the touching ones get the rest of their data. The
+ * first pass runs over the entries, not rows then entries: the end of a row (0 to ~10
+ * entries) is unpredictable too. */
 static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair_batch *b)
 {
     dem_domain *d = c->d;
@@ -64,8 +66,7 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
      * pointers from the domain at every entry */
     const double *restrict x = d->x, *restrict v = d->v, *restrict w = d->w;
     const double *restrict rad = d->radius, *restrict im = d->inv_mass;
-    const int64_t *restrict start = pl->start;
-    const int32_t *restrict pj = pl->j, *restrict mat = d->mat;
+    const int32_t *restrict pj = pl->j, *restrict mat = d->mat, *restrict entry_row = d->entry_row;
     const uint8_t *restrict image = pl->image;
     uint8_t *restrict active = pl->active;
     double *restrict hist = pl->hist, *restrict slot = d->slot;
@@ -75,36 +76,32 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     int m = 0, lost = 0;
     int32_t row_of[DEM_PAIR_BATCH]; /* the row of each touching entry, for the second pass */
     int64_t lost_k[DEM_PAIR_BATCH]; /* entries that stopped touching */
-    for (int64_t i = row; k0 < k1; i++) {
-        const int64_t e1 = start[i + 1] < k1 ? start[i + 1] : k1;
-        const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
-        for (int64_t k = k0; k < e1; k++) {
-            const int32_t j = pj[k];
-            double xj0 = x[3 * j], xj1 = x[3 * j + 1], xj2 = x[3 * j + 2];
-            if (periodic) { /* the partner's periodic image (a zero shift elsewhere) */
-                const double *sh = c->shift[image[k]];
-                xj0 += sh[0];
-                xj1 += sh[1];
-                xj2 += sh[2];
-            }
-            const double dx = xi0 - xj0, dy = xi1 - xj1, dz = xi2 - xj2;
-            const double rj = rad[j], rsum = ri + rj;
-            const double r2 = dx * dx + dy * dy + dz * dz;
-            const int touch = r2 < rsum * rsum;
-            b->k[m] = k;
-            b->j[m] = j;
-            b->dx[m] = dx;
-            b->dy[m] = dy;
-            b->dz[m] = dz;
-            b->r2[m] = r2;
-            b->ri[m] = ri;
-            b->rj[m] = rj;
-            row_of[m] = (int32_t)(i - row);
-            m += touch;
-            lost_k[lost] = k;
-            lost += active[k] > touch; /* active is 0 or 1: it was touching and is no longer */
+    for (int64_t k = k0; k < k1; k++) {
+        const int32_t i = entry_row[k], j = pj[k];
+        const double ri = rad[i];
+        double xj0 = x[3 * j], xj1 = x[3 * j + 1], xj2 = x[3 * j + 2];
+        if (periodic) { /* the partner's periodic image (a zero shift elsewhere) */
+            const double *sh = c->shift[image[k]];
+            xj0 += sh[0];
+            xj1 += sh[1];
+            xj2 += sh[2];
         }
-        k0 = e1;
+        const double dx = x[3 * i] - xj0, dy = x[3 * i + 1] - xj1, dz = x[3 * i + 2] - xj2;
+        const double rj = rad[j], rsum = ri + rj;
+        const double r2 = dx * dx + dy * dy + dz * dz;
+        const int touch = r2 < rsum * rsum;
+        b->k[m] = k;
+        b->j[m] = j;
+        b->dx[m] = dx;
+        b->dy[m] = dy;
+        b->dz[m] = dz;
+        b->r2[m] = r2;
+        b->ri[m] = ri;
+        b->rj[m] = rj;
+        row_of[m] = (int32_t)(i - row);
+        m += touch;
+        lost_k[lost] = k;
+        lost += active[k] > touch; /* active is 0 or 1: it was touching and is no longer */
     }
     for (int q = 0; q < lost; q++) {
         const int64_t k = lost_k[q];
