@@ -51,14 +51,15 @@ typedef struct sweep_ctx {
     const pair_props *all_pairs; /* the pair type of every contact (one particle material), or NULL */
 } sweep_ctx;
 
-/* Gathers the contacts among list entries [k0, k1) (the first in row `row`) into the batch;
- * an entry whose spheres no longer touch forgets its springs and clears its slot once.
+/* Gathers the contacts among list entries [k0, k1) (the first in row `row`) into the batch,
+ * and the row of each (minus `row`) into row_of; an entry whose spheres no longer touch
+ * forgets its springs and clears its slot once.
  * Two passes: the distance test writes every entry's geometry at the next free batch place
  * and advances it only for touching pairs (branch-free: whether a pair touches is a coin
  * toss the branch predictor loses), then the touching ones get the rest of their data. The
  * first pass runs over the entries, not rows then entries: the end of a row (0 to ~10
  * entries) is unpredictable too. */
-static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair_batch *b)
+static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair_batch *b, int32_t *row_of)
 {
     dem_domain *d = c->d;
     pair_list *pl = &d->pairs_cur;
@@ -74,7 +75,6 @@ static void gather(const sweep_ctx *c, int64_t row, int64_t k0, int64_t k1, pair
     const int n_mat = d->n_materials;
     const int periodic = c->periodic;
     int m = 0, lost = 0;
-    int32_t row_of[DEM_PAIR_BATCH]; /* the row of each touching entry, for the second pass */
     int64_t lost_k[DEM_PAIR_BATCH]; /* entries that stopped touching */
     for (int64_t k = k0; k < k1; k++) {
         const int32_t i = entry_row[k], j = pj[k];
@@ -136,7 +136,7 @@ static inline int direct(const dem_domain *d, int64_t p, int64_t r0, int64_t r1)
 }
 
 /* Contact q of the batch back into the list: springs, reaction slot, activity; its force and
- * torque on i added to the row sums acc (force 3, torque 3), the reaction to a direct
+ * torque on i added to its row's sums acc (force 3, torque 3), the reaction to a direct
  * partner's sum. */
 static inline void scatter(const sweep_ctx *c, const pair_batch *b, int q, double *acc, int64_t *bad_pair, int64_t r0,
                            int64_t r1)
@@ -374,7 +374,9 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t *start = d->pairs_cur.start;
         const int64_t kend = start[r1];
         int64_t row = r0, k = start[r0];
-        double acc[6] = {0, 0, 0, 0, 0, 0}; /* force and torque sums of row `row` so far */
+        double acc[DEM_PAIR_BATCH][6]; /* force and torque sums of the batch's rows (from `row`) */
+        int32_t row_of[DEM_PAIR_BATCH]; /* the batch's contacts' rows (minus `row`) */
+        for (int a = 0; a < 6; a++) acc[0][a] = 0.0;
         int64_t n_deferred = 0;
         for (int64_t i = r0; i < r1; i++) { /* direct particles' reaction sums start at zero */
             d->is_direct[i] = (uint8_t)direct(d, i, r0, r1);
@@ -385,21 +387,29 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         }
         if (use_split) deferred_count[tid] = n_deferred;
         while (row < r1) {
-            const int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
-            gather(&ctx, row, k, k1, &b);
+            /* a batch: at most DEM_PAIR_BATCH entries, from at most DEM_PAIR_BATCH rows */
+            int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
+            if (r1 - row > DEM_PAIR_BATCH && start[row + DEM_PAIR_BATCH] < k1) k1 = start[row + DEM_PAIR_BATCH];
+            gather(&ctx, row, k, k1, &b, row_of);
             dem_pair_batch_law(&b, dt_hist);
             if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx.hist);
-            /* in list order; each row whose entries are all done is finished (or parked) */
-            int q = 0;
-            for (;;) {
-                const int64_t row_end = start[row + 1];
-                for (; q < b.m && b.k[q] < row_end; q++) scatter(&ctx, &b, q, acc, &res.bad_pair, r0, r1);
-                if (row_end > k1) break; /* the row goes on in the next batch */
+            /* rows [row, fin) end in this batch; row fin (if below the cap) goes on in the next */
+            const int64_t cap = r1 - row > DEM_PAIR_BATCH ? row + DEM_PAIR_BATCH : r1;
+            int64_t fin = row;
+            while (fin < cap && start[fin + 1] <= k1) fin++;
+            const int64_t n_acc = fin < cap ? fin - row + 1 : fin - row; /* rows with contacts here */
+            for (int64_t r = 1; r < n_acc; r++)
+                for (int a = 0; a < 6; a++) acc[r][a] = 0.0;
+            /* in list order, so each row's sums are added up as the scalar order has them
+             * (one loop over the contacts, not rows then contacts: the end of a row is
+             * unpredictable for the branch predictor) */
+            for (int q = 0; q < b.m; q++) scatter(&ctx, &b, q, acc[row_of[q]], &res.bad_pair, r0, r1);
+            for (int64_t o = 0; row < fin; row++, o++) {
                 if (any_mesh && row >= mesh_done) { /* the next block's mesh contacts, batched */
                     mesh_done = r1 - row > MESH_ROWS ? row + MESH_ROWS : r1;
                     dem_mesh_contacts_rows(d, row, mesh_done, dt_hist, mesh_batch, &res.bad_wall);
                 }
-                double f[3] = {acc[0], acc[1], acc[2]}, t[3] = {acc[3], acc[4], acc[5]};
+                double f[3] = {acc[o][0], acc[o][1], acc[o][2]}, t[3] = {acc[o][3], acc[o][4], acc[o][5]};
                 /* direct: finish now; else park the row sums in the force arrays and finish
                  * after the barrier */
                 if (ctx.is_direct[row]) {
@@ -410,9 +420,9 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
                         ctx.s.t[3 * row + a] = t[a];
                     }
                 }
-                for (int a = 0; a < 6; a++) acc[a] = 0.0;
-                if (++row >= r1) break;
             }
+            /* the unfinished row's sums so far start the next batch's */
+            for (int a = 0; a < 6; a++) acc[0][a] = fin < cap ? acc[n_acc - 1][a] : 0.0;
             k = k1;
         }
 #ifdef _OPENMP
