@@ -6,7 +6,8 @@
  * in order, particle p's forces are therefore complete once row p is done: its own row gives
  * the i-side, and every entry naming p as partner was in an earlier row, whose reaction waits
  * in its reaction sum, kept in its force and torque arrays (the old forces are not needed once
- * the step is open; the sweep zeroes them first). p is then finished at once — reactions added,
+ * the step is open; the sweep zeroes them first). p is then finished once the batch holding the
+ * end of its row is scattered (rows go in batches of entries) — reactions added,
  * walls added, closing half kick, opening half kick and drift — and nothing later reads its old
  * state. Such particles, named only by earlier rows of the same thread, are "direct".
  * The others — named by a later row (periodic wrap) or by another thread's rows, where the sum
