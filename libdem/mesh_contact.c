@@ -16,7 +16,6 @@
 #include "pair_batch.h"
 #include "triangle.h"
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define MAX_TOUCHING 64
@@ -224,7 +223,7 @@ int dem_mesh_scratch_reserve(dem_domain *d)
 {
     const int need = d->n_meshes > 0 ? d->def.num_threads : 0;
     if (need <= d->mesh_scratch_threads) return 1;
-    void *p = realloc(d->mesh_scratch, (size_t)need * sizeof(pair_batch));
+    void *p = dem_realloc_array(d->mesh_scratch, (size_t)need, sizeof(pair_batch));
     if (!p) return 0;
     d->mesh_scratch = p;
     d->mesh_scratch_threads = need;

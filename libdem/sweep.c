@@ -373,7 +373,6 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         pair_batch *mesh_batch = any_mesh ? (pair_batch *)d->mesh_scratch + tid : NULL;
         int64_t mesh_done = r0; /* rows before this have their mesh contacts evaluated */
         const int64_t *start = d->pairs_cur.start;
-        const int64_t kend = start[r1];
         int64_t row = r0, k = start[r0];
         double acc[DEM_PAIR_BATCH][6]; /* force and torque sums of the batch's rows (from `row`) */
         int32_t row_of[DEM_PAIR_BATCH]; /* the batch's contacts' rows (minus `row`) */
@@ -388,14 +387,13 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         }
         if (use_split) deferred_count[tid] = n_deferred;
         while (row < r1) {
-            /* a batch: at most DEM_PAIR_BATCH entries, from at most DEM_PAIR_BATCH rows */
-            int64_t k1 = kend - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : kend;
-            if (r1 - row > DEM_PAIR_BATCH && start[row + DEM_PAIR_BATCH] < k1) k1 = start[row + DEM_PAIR_BATCH];
+            /* a batch: at most DEM_PAIR_BATCH entries, from rows [row, cap) */
+            const int64_t cap = r1 - row > DEM_PAIR_BATCH ? row + DEM_PAIR_BATCH : r1;
+            const int64_t k1 = start[cap] - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : start[cap];
             gather(&ctx, row, k, k1, &b, row_of);
             dem_pair_batch_law(&b, dt_hist);
             if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx.hist);
             /* rows [row, fin) end in this batch; row fin (if below the cap) goes on in the next */
-            const int64_t cap = r1 - row > DEM_PAIR_BATCH ? row + DEM_PAIR_BATCH : r1;
             int64_t fin = row;
             while (fin < cap && start[fin + 1] <= k1) fin++;
             const int64_t n_acc = fin < cap ? fin - row + 1 : fin - row; /* rows with contacts here */
