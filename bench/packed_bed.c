@@ -27,28 +27,31 @@
 #include <unistd.h>
 #endif
 
-/* The calling thread's processor cycles (user space) from the hardware counter, or -1 where
- * the machine or its settings offer none. Why: the VMs this runs on change speed by +-15 %
- * over minutes (and a session's machine type is not always the same), so particle-steps per
- * second alone cannot compare runs of different hours; cycles per particle-step can. Counted
- * for the main thread only, so meaningful for 1-thread runs. */
-static int cycle_counter_open(void)
+/* A hardware counter of the calling thread (user space): PERF_COUNT_HW_CPU_CYCLES or
+ * _INSTRUCTIONS; -1 where the machine or its settings offer none. Why cycles: the VMs this
+ * runs on change speed by +-15 % over minutes (and a session's machine type is not always the
+ * same), so particle-steps per second alone cannot compare runs of different hours; cycles
+ * per particle-step can. Why instructions: the work per particle-step, whatever the caches do
+ * (constant over bed sizes = cost linear in N). Counted for the main thread only, so
+ * meaningful for 1-thread runs. */
+static int counter_open(unsigned long long config)
 {
 #ifdef __linux__
     struct perf_event_attr a;
     memset(&a, 0, sizeof a);
     a.type = PERF_TYPE_HARDWARE;
     a.size = sizeof a;
-    a.config = PERF_COUNT_HW_CPU_CYCLES;
+    a.config = config;
     a.exclude_kernel = 1;
     a.exclude_hv = 1;
     return (int)syscall(SYS_perf_event_open, &a, 0, -1, -1, 0);
 #else
+    (void)config;
     return -1;
 #endif
 }
 
-static double cycle_counter_read(int fd)
+static double counter_read(int fd)
 {
 #ifdef __linux__
     uint64_t v;
@@ -218,22 +221,33 @@ int main(int argc, char **argv)
     }
 
     FILE *out = csv ? fopen(csv, "a") : NULL;
+    if (csv && !out) {
+        fprintf(stderr, "packed_bed: cannot open %s for appending\n", csv);
+        dem_domain_destroy(d);
+        return 1;
+    }
+    if (out && ftell(out) == 0) /* a new file: the header first */
+        fprintf(out, "particles,mu_r,threads,steps,mpart_steps_per_s,seconds,contacts_per_particle,frac_neighbor,"
+                     "frac_force_sweep,frac_integration_est,neighbor_builds,libdem_bytes_per_particle,peak_rss_mib,"
+                     "settle_seconds,cycles_per_particle_step,clock_ghz,instructions_per_particle_step\n");
     char list[64];
     snprintf(list, sizeof list, "%s", threads_arg);
     int thread_counts[16], n_counts = 0;
     for (char *tok = strtok(list, ","); tok && n_counts < 16; tok = strtok(NULL, ",")) thread_counts[n_counts++] = atoi(tok);
-    const int cycles_fd = cycle_counter_open();
+    const int cycles_fd = counter_open(PERF_COUNT_HW_CPU_CYCLES), instr_fd = counter_open(PERF_COUNT_HW_INSTRUCTIONS);
     for (int run = 0; run < repeat * n_counts; run++) {
         int nt = thread_counts[run % n_counts];
         dem_domain_set_num_threads(d, nt);
         dem_domain_profile_reset(d);
-        const double c1 = cycle_counter_read(cycles_fd);
+        const double c1 = counter_read(cycles_fd), i1 = counter_read(instr_fd);
         double t1 = now_s();
         if ((s = dem_domain_step(d, steps)) != DEM_OK) die(d, s, "timed run");
         double el = now_s() - t1;
-        const double c2 = cycle_counter_read(cycles_fd);
-        /* cycles per particle-step and the clock they ran at (1 thread, where counted) */
+        const double c2 = counter_read(cycles_fd), i2 = counter_read(instr_fd);
+        /* cycles and instructions per particle-step, the clock they ran at (1 thread, where
+         * counted) */
         const double cps = nt == 1 && c1 >= 0 && c2 >= 0 ? (c2 - c1) / ((double)n * steps) : -1.0;
+        const double ips = nt == 1 && i1 >= 0 && i2 >= 0 ? (i2 - i1) / ((double)n * steps) : -1.0;
         const double ghz = cps > 0 ? (c2 - c1) / el / 1e9 : -1.0;
         dem_profile pr;
         dem_diagnostics g;
@@ -259,18 +273,21 @@ int main(int argc, char **argv)
                rss / 1024.0,
                rss * 1024.0 / (double)n);
         if (cps > 0) printf("  %.0f cycles/particle-step at %.2f GHz", cps, ghz);
+        if (ips > 0) printf("  %.0f instructions/particle-step", ips);
         printf("\n");
-        char cyc[64] = ",";
+        char cyc[64] = ",", ins[32] = "";
         if (cps > 0) snprintf(cyc, sizeof cyc, "%.1f,%.3f", cps, ghz);
+        if (ips > 0) snprintf(ins, sizeof ins, "%.1f", ips);
         if (out)
-            fprintf(out, "%lld,%.2f,%d,%d,%.4f,%.3f,%.2f,%.3f,%.3f,%.3f,%lld,%.0f,%.1f,%.1f,%s\n", (long long)n, mu_r, nt,
+            fprintf(out, "%lld,%.2f,%d,%d,%.4f,%.3f,%.2f,%.3f,%.3f,%.3f,%lld,%.0f,%.1f,%.1f,%s,%s\n", (long long)n, mu_r, nt,
                     steps, rate / 1e6, el, cpp, pr.neighbor_s / el, (pr.contact_s + pr.integrate_s) / el, integ_frac,
-                    (long long)pr.neighbor_builds, mem_pp, rss / 1024.0, settle_s, cyc);
+                    (long long)pr.neighbor_builds, mem_pp, rss / 1024.0, settle_s, cyc, ins);
         fflush(stdout);
     }
     if (out) fclose(out);
 #ifdef __linux__
     if (cycles_fd >= 0) close(cycles_fd);
+    if (instr_fd >= 0) close(instr_fd);
 #endif
     dem_domain_destroy(d);
     return 0;

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 out=bench/results
 mkdir -p "$out"
 csv=$out/packed_bed.csv
-echo "particles,mu_r,threads,steps,mpart_steps_per_s,seconds,contacts_per_particle,frac_neighbor,frac_force_sweep,frac_integration_est,neighbor_builds,libdem_bytes_per_particle,peak_rss_mib,settle_seconds,cycles_per_particle_step,clock_ghz" > "$csv"
+: > "$csv" # packed_bed writes the header into the empty file
 {
     echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
     echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
