@@ -113,12 +113,15 @@ DEM_INLINE void contact_law(const pair_props *pp, const contact_in *c, double dt
         ft[0] *= s;
         ft[1] *= s;
         ft[2] *= s;
-        /* keep the spring consistent with the capped force: -kt xi - gt vt = ft */
+        /* Sliding: the spring alone carries the capped force (-kt xi = ft), the dashpot acts in
+         * stick only. Resetting xi so that -kt xi - gt vt = ft instead leaves the spring pointing
+         * along the slip whenever the dashpot alone exceeds mu F_n (damped impacts), and as kt
+         * grows the next steps' friction then pushes along the slip (docs/libdem.md). */
         if (kt > 0.0) {
             const double ik = -1.0 / kt;
-            xi[0] = (ft[0] + gt * vt[0]) * ik;
-            xi[1] = (ft[1] + gt * vt[1]) * ik;
-            xi[2] = (ft[2] + gt * vt[2]) * ik;
+            xi[0] = ft[0] * ik;
+            xi[1] = ft[1] * ik;
+            xi[2] = ft[2] * ik;
         }
     }
 

@@ -161,9 +161,9 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
         const double fc0 = ft0 * cap, fc1 = ft1 * cap, fc2 = ft2 * cap;
         const double ik = -1.0 / kt;
         const int reset = slide & (kt > 0.0);
-        b->h[0][q] = reset ? (fc0 + gt * vt0) * ik : x0;
-        b->h[1][q] = reset ? (fc1 + gt * vt1) * ik : x1;
-        b->h[2][q] = reset ? (fc2 + gt * vt2) * ik : x2;
+        b->h[0][q] = reset ? fc0 * ik : x0;
+        b->h[1][q] = reset ? fc1 * ik : x1;
+        b->h[2][q] = reset ? fc2 * ik : x2;
         b->force[0][q] = slide ? fc0 : ft0;
         b->force[1][q] = slide ? fc1 : ft1;
         b->force[2][q] = slide ? fc2 : ft2;

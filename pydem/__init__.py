@@ -3,7 +3,7 @@
     import pydem
     dom = pydem.Domain(lo=(0, 0, 0), hi=(0.1, 0.1, 0.1))
 """
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 try:
     from ._libdem import ffi as _ffi, lib as _lib

@@ -17,6 +17,7 @@ import numpy as np
 from . import compare as cmp
 from . import screening
 from .campaign import Campaign
+from .campaign.store import check_same_physics, physics_of
 from .measurements import Measurement, load
 from .rigs import RIGS
 
@@ -103,6 +104,11 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     for path in campaigns:
         store = Campaign.open(path).store
         stores[store.spec.rig] = store
+    physics = check_same_physics(stores.values())
+    from . import LIBDEM_VERSION
+    if physics != physics_of(LIBDEM_VERSION):
+        _say(f"  note: the campaigns were run with libdem {physics}, this is libdem {LIBDEM_VERSION} (another contact "
+             f"law): the confirming DEM runs use the new one")
     names = next(iter(stores.values())).spec.names
     for rig, st in stores.items():
         if st.spec.names != names:

@@ -16,7 +16,7 @@ import numpy as np
 from ..rigs import RIGS
 from .design import design_points
 from .spec import CampaignSpec
-from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError
+from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError, physics_of
 
 
 def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
@@ -152,6 +152,11 @@ class Campaign:
                              f"with protocol {rig_cls.protocol} (see the rig's `protocol` note); adding runs would mix two "
                              f"definitions of the metrics in one data set. Start a new store, or continue it from commit "
                              f"{s.provenance.get('git_commit', 'unknown')}.")
+        from .. import LIBDEM_VERSION
+        if s.physics != physics_of(LIBDEM_VERSION):
+            raise StoreError(f"{s.path}: its runs were made with libdem {s.provenance.get('libdem', '0.1.0')}, this is "
+                             f"libdem {LIBDEM_VERSION}, whose contact law gives different results (CHANGELOG.md); adding "
+                             f"runs would mix two models in one data set. Start a new store.")
         s.lock()
         try:
             todo = [i for i in s.pending(retry_failed) if points is None or s.points[i] < points][:max_runs]
@@ -185,30 +190,14 @@ class Campaign:
         progress.update("error" not in out)
 
     def _run_local(self, workers, args, progress):
-        import multiprocessing as mp
-        from concurrent.futures import ProcessPoolExecutor, as_completed
-        from concurrent.futures.process import BrokenProcessPool
+        from .workers import run_local
         threads = int(self.store.spec.fixed.get("num_threads", 1))
         workers = workers or max(1, (os.cpu_count() or 1) // threads)
-        # spawn: a fresh interpreter per worker (forking a process that holds OpenMP threads is unsafe)
-        with ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=mp.get_context("spawn")) as pool:
-            futures = {pool.submit(simulate, *a): i for i, a in args.items()}
-            recorded = set()
-            try:
-                for fut in as_completed(futures):
-                    self._finish(futures[fut], fut.result(), progress)
-                    recorded.add(fut)
-            except BrokenProcessPool:
-                raise StoreError("a worker process died (killed or out of memory); finished runs are saved, the others "
-                                 "stay pending: run the campaign again to continue") from None
-            except BaseException:  # Ctrl-C: queued runs are dropped, the ones running are finished and kept
-                for f in futures:
-                    f.cancel()
-                pool.shutdown(wait=True)
-                for f in futures:
-                    if f not in recorded and f.done() and not f.cancelled() and f.exception() is None:
-                        self._finish(futures[f], f.result(), progress)
-                raise
+
+        def say(msg):
+            sys.stderr.write(f"\n  {msg}\n")
+
+        run_local(args, simulate, min(workers, len(args)), lambda i, out: self._finish(i, out, progress), say)
 
     def _run_dask(self, address, args, progress):
         try:

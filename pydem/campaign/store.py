@@ -6,7 +6,9 @@ runs, `point` says which design point each row measures.
 Crash safety: the store is small (kilobytes per hundred runs), so every update writes a complete
 new file next to it, flushes it to disk and atomically renames it over the old one. A kill at any
 moment leaves either the previous or the new store, never a torn one, and no finished run is
-lost once `save` has returned. One writer at a time (a lock file next to the store)."""
+lost once `save` has returned. One writer at a time (a lock file next to the store, removed when
+the writer finishes); readers only read: a temporary file left by a killed writer is removed by
+the next writer, never by a reader (it may be the live writer's file about to be renamed)."""
 from __future__ import annotations
 
 import fcntl
@@ -32,6 +34,24 @@ def _strings(dataset) -> list[str]:
 
 class StoreError(RuntimeError):
     """A campaign store that cannot be read, written or locked."""
+
+
+def physics_of(libdem_version: str) -> str:
+    """major.minor of a libdem version: runs of two libdem versions that share it are comparable."""
+    return ".".join(libdem_version.split(".")[:2])
+
+
+def check_same_physics(stores, what: str = "calibrate from") -> str:
+    """The stores' common libdem major.minor; a StoreError naming them when they differ (results
+    of two contact laws in one data set would be fitted as one model)."""
+    seen = {}
+    for st in stores:
+        seen.setdefault(st.physics, []).append(str(st.path))
+    if len(seen) > 1:
+        detail = "; ".join(f"libdem {v}: {', '.join(paths)}" for v, paths in sorted(seen.items()))
+        raise StoreError(f"cannot {what} campaign stores made with different libdem contact laws ({detail}); "
+                         f"re-run the older ones with this libdem")
+    return next(iter(seen)) if seen else ""
 
 
 class CampaignStore:
@@ -109,6 +129,12 @@ class CampaignStore:
         """The rig protocol the runs were measured with (stores from before the stamp: 1)."""
         return int(self.provenance.get("rig_protocol", 1))
 
+    @property
+    def physics(self) -> str:
+        """The contact-law generation the runs were made with: libdem's major.minor version (a
+        minor release changes results, e.g. 0.2 the Coulomb cap in damped sliding contacts)."""
+        return physics_of(str(self.provenance.get("libdem", "0.1.0")))
+
     def counts(self) -> dict[str, int]:
         return {name: int((self.status == s).sum()) for s, name in STATUS_NAMES.items()}
 
@@ -138,17 +164,38 @@ class CampaignStore:
 
     # ---- file ------------------------------------------------------------------------
     def lock(self):
-        """Exclusive writer lock; a second `campaign run` on the same store stops with an error."""
-        self._lock = open(str(self.path) + ".lock", "a+")
-        try:
-            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            self._lock.close()
-            self._lock = None
-            raise StoreError(f"{self.path} is being written by another campaign process (lock {self.path}.lock)") from None
+        """Exclusive writer lock; a second `campaign run` on the same store stops with an error.
+        The writer alone cleans up what an earlier, killed writer left (its temporary files);
+        readers never delete or modify anything."""
+        lock_path = str(self.path) + ".lock"
+        for _ in range(10):
+            fh = open(lock_path, "a+")
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                fh.close()
+                raise StoreError(f"{self.path} is being written by another campaign process (lock {lock_path})") from None
+            try:  # the file may have been removed by a writer that finished meanwhile: lock the live one
+                same = os.fstat(fh.fileno()).st_ino == os.stat(lock_path).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self._lock = fh
+                break
+            fh.close()
+        else:
+            raise StoreError(f"{self.path}: could not take the writer lock {lock_path}")
+        for stale in self.path.parent.glob(f".{self.path.name}.tmp-*"):  # a save interrupted by a kill
+            stale.unlink(missing_ok=True)
 
     def unlock(self):
+        """Releases the writer lock and removes the lock file (removed while still held, so no
+        other writer can hold a lock on a file that is gone)."""
         if self._lock is not None:
+            try:
+                os.unlink(str(self.path) + ".lock")
+            except FileNotFoundError:
+                pass
             fcntl.flock(self._lock, fcntl.LOCK_UN)
             self._lock.close()
             self._lock = None
@@ -189,8 +236,6 @@ class CampaignStore:
         path = Path(path)
         if not path.exists():
             raise StoreError(f"{path}: no such campaign store")
-        for stale in path.parent.glob(f".{path.name}.tmp-*"):  # a write interrupted by a kill
-            stale.unlink(missing_ok=True)
         try:
             with h5py.File(path, "r") as f:
                 if f.attrs.get("format") != FORMAT:

@@ -1,0 +1,120 @@
+"""Local campaign runs, one fresh worker process per run, at most `workers` at a time.
+
+Why not a ProcessPoolExecutor: when one of its workers dies (the out-of-memory killer, a
+`kill -9`), the whole pool breaks and the other workers' runs in progress are thrown away. Here
+a lost worker costs exactly its own run, which is retried once and then recorded as failed;
+the campaign goes on. A worker also exits on its own when the campaign process dies (a
+watchdog on its parent's pid, and PR_SET_PDEATHSIG on Linux), so a killed campaign leaves no
+idle workers behind.
+
+A run's result reaches the parent through a pipe; the parent saves it before it starts the
+next run, so nothing reported finished is ever lost."""
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import signal
+import sys
+import threading
+import time
+from multiprocessing.connection import wait
+from typing import Callable
+
+RETRIES_AFTER_LOSS = 1  # a worker killed from outside: its run is tried once more
+
+
+def _die_with_parent(parent: int):
+    """Exit as soon as the campaign process that started us is gone."""
+    try:  # Linux: the kernel signals us when the parent dies
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+    def watch():
+        while True:
+            if os.getppid() != parent:
+                os._exit(3)
+            time.sleep(0.5)
+
+    threading.Thread(target=watch, daemon=True).start()
+    if os.getppid() != parent:  # died before the watch started
+        os._exit(3)
+
+
+def _worker(conn, parent: int, func, args):
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the campaign: it lets running runs finish
+    _die_with_parent(parent)
+    try:
+        out = func(*args)
+    except BaseException as exc:  # func reports its own errors; this is a last resort
+        out = {"error": f"{type(exc).__name__}: {exc}", "wall": 0.0}
+    conn.send(out)
+    conn.close()
+
+
+def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int, dict], None],
+              say: Callable[[str], None] | None = None):
+    """Runs func(*jobs[i]) for every i, `workers` at a time, each in a new process; calls
+    on_result(i, result) in the parent as each ends. A worker that dies without a result
+    (killed) is retried once, then reported as {"error": "worker process died ..."}.
+    Ctrl-C: no new runs start, the running ones finish and are reported, then it re-raises;
+    a second Ctrl-C stops them too."""
+    ctx = mp.get_context("spawn")  # a fresh interpreter (forking a process that holds OpenMP threads is unsafe)
+    queue = list(jobs)
+    tries = {i: 0 for i in jobs}
+    running: dict = {}  # sentinel -> (index, process, connection, start)
+    parent = os.getpid()
+    interrupted = None
+
+    def start(i):
+        recv, send = ctx.Pipe(duplex=False)
+        p = ctx.Process(target=_worker, args=(send, parent, func, jobs[i]), daemon=True)
+        p.start()
+        send.close()
+        running[p.sentinel] = (i, p, recv, time.perf_counter())
+
+    try:
+        while queue or running:
+            while queue and len(running) < workers and interrupted is None:
+                start(queue.pop(0))
+            if not running:
+                break
+            try:
+                ready = wait(list(running), timeout=1.0)
+            except KeyboardInterrupt as exc:
+                if interrupted is not None:
+                    raise
+                interrupted = exc
+                if say:
+                    say(f"interrupted: waiting for {len(running)} running run(s) to finish (Ctrl-C again to stop them)")
+                continue
+            for sentinel in ready:
+                i, p, recv, t0 = running.pop(sentinel)
+                out = None
+                try:
+                    if recv.poll():
+                        out = recv.recv()
+                except (EOFError, OSError):
+                    out = None
+                recv.close()
+                p.join()
+                if out is None:  # killed from outside (OOM killer, kill -9): no result
+                    tries[i] += 1
+                    how = f"signal {-p.exitcode}" if p.exitcode and p.exitcode < 0 else f"exit code {p.exitcode}"
+                    if tries[i] <= RETRIES_AFTER_LOSS and interrupted is None:
+                        if say:
+                            say(f"run {i}: its worker process died ({how}); running it again")
+                        queue.insert(0, i)
+                        continue
+                    out = {"error": f"worker process died ({how}) {tries[i]} time(s)", "wall": time.perf_counter() - t0}
+                on_result(i, out)
+        if interrupted is not None:
+            raise interrupted
+    finally:
+        for i, p, recv, _ in running.values():  # only on an error or a second Ctrl-C
+            p.kill()
+            p.join()
+            recv.close()
+    sys.stderr.flush()
