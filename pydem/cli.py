@@ -51,9 +51,10 @@ def main(argv: list[str] | None = None) -> int:
     rig.add_argument("--frames", help="directory for PNG frames")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
-    from . import calibrate, cli_campaign, cli_compare
+    from . import calibrate, cli_campaign, cli_compare, cli_diagnose
     cli_campaign.add_parser(sub)
     cli_compare.add_parser(sub)
+    cli_diagnose.add_parser(sub)
     calibrate.add_parser(sub)
     args = ap.parse_args(argv)
     if hasattr(args, "func"):

@@ -1,0 +1,275 @@
+"""The diagnosis: calibrate the base model, show where it fails, test every candidate effect,
+give a verdict, add the chosen effect and show the error before and after.
+
+Per candidate E (parameter eta_E, neutral eta_0):
+- a score (Lagrange-multiplier) test at eta_0 with the base parameters re-adjusted:
+  S = (J_E' W r)^2 / (J_E' M J_E), M = W - W J (J' W J)^-1 J' W (DESIGN section 9); it needs
+  only the base fit, and its projected signature M^1/2 J_E gives the cosine between two
+  candidates (near 1: these conditions cannot tell them apart);
+- the profile-likelihood ratio LR = chi2_base - chi2_E with eta_E and the base parameters
+  refitted in the campaign box. The verdict uses LR: the score test is a linearisation at eta_0
+  and understates strong effects (cohesion changes the nets' slopes far from zero), LR does
+  not. Both are chi^2_1 under the base model; for a one-sided candidate (cohesion >= 0, eta_0 at
+  the edge of its range) the null distribution is the 50:50 mixture of 0 and chi^2_1, so
+  p = sf(LR) / 2. delta_bic = BIC_E - BIC_base (negative favours the effect).
+
+Verdicts: `no_effect_needed` (no candidate significant at ALPHA and the base fit acceptable),
+`effect` (one candidate clearly best), `indistinguishable` (two or more significant with LRs
+within DELTA_TIE of each other), `unexplained` (the base fit is rejected and no candidate, or
+not even the best, brings the fit to an acceptable level)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+
+from .candidates import Candidate
+from .fit import Fit, Model, minimise, posterior
+from .quantities import Observation
+
+ALPHA = 0.01        # per-candidate significance (3 candidates: family-wise < 3 %)
+ACCEPT = 0.001      # a fit with chi^2 p-value below this is rejected
+DELTA_TIE = 2.0     # LRs closer than this (a BIC difference < 2: "not worth a bare mention")
+
+
+@dataclass
+class CandidateResult:
+    effect: str
+    parameter: str
+    unit: str
+    side: str
+    neutral: float
+    score: float
+    score_step: float
+    statistic: float          # the profile-likelihood ratio chi2_base - chi2_E
+    p_value: float
+    delta_bic: float
+    estimate: float           # eta_E at the refit
+    estimate_lo: float = float("nan")
+    estimate_hi: float = float("nan")
+    fit: Fit | None = None
+
+    def as_dict(self) -> dict:
+        return {"effect": self.effect, "parameter": self.parameter, "unit": self.unit, "statistic": self.statistic,
+                "p_value": self.p_value, "delta_bic": self.delta_bic, "estimate": self.estimate,
+                "estimate_interval": [self.estimate_lo, self.estimate_hi], "neutral": self.neutral,
+                "score": self.score, "score_step": self.score_step, "side": self.side}
+
+
+@dataclass
+class Diagnosis:
+    material: str
+    observations: list[Observation]
+    base: Fit
+    base_model: Model
+    candidates: list[CandidateResult]
+    not_covered: list[str]
+    verdict: str
+    effect: str | None
+    after: Fit | None
+    after_model: Model | None
+    similarity: dict             # "a|b" -> cosine of projected signatures
+    separating: dict             # "a|b" -> the condition that would separate them
+    groups: list[dict]           # per-condition-group base recalibration
+    loco: dict                   # leave-one-condition-out relative RMSE, before/after
+    notes: list[str] = field(default_factory=list)
+
+    def summary_of(self, fit: Fit | None, model: Model | None) -> dict | None:
+        if fit is None:
+            return None
+        pred = model.predict(fit.best)
+        rel = (model.y - pred) / model.y
+        return {"chi2": fit.chi2, "chi2_per_dof": fit.chi2_per_dof, "dof": fit.dof, "p_value": fit.p_value,
+                "rmse_relative": float(np.sqrt(np.mean(rel ** 2))), "n": fit.n, "bic": fit.bic,
+                "loco_rmse_relative": self.loco.get("after" if model is self.after_model else "before")}
+
+    def residual_table(self, after: bool = False) -> list[dict]:
+        fit, model = (self.after, self.after_model) if after else (self.base, self.base_model)
+        pred = model.predict(fit.best)
+        rows = []
+        for o, f, s, net in zip(self.observations, pred, model.sigma, model.nets):
+            rows.append({"quantity": o.quantity.key, "conditions": o.conditions, "label": o.label,
+                         "measured": o.value, "u_measured": o.uncertainty, "model": float(f), "u_model": net.net_error, "scatter": net.scatter, "sigma": float(s),
+                         "z": float((o.value - f) / s), "relative": float((o.value - f) / o.value)})
+        return rows
+
+    def as_dict(self) -> dict:
+        params = {}
+        final = self.after if self.after is not None else self.base
+        post = final.posterior.get("parameters", {})
+        for name in final.names:
+            p = post.get(name, {})
+            params[name] = {"estimate": float(final.as_dict()[name]), "lo": p.get("lo"), "hi": p.get("hi"),
+                            "mean": p.get("mean"), "sd": p.get("sd"), "at_edge": p.get("at_edge")}
+        return {"material": self.material, "verdict": self.verdict, "effect": self.effect,
+                "candidates": [c.as_dict() for c in self.candidates], "not_covered": self.not_covered,
+                "before": self.summary_of(self.base, self.base_model),
+                "after": self.summary_of(self.after, self.after_model),
+                "parameters": params, "base_parameters": {n: v for n, v in self.base.posterior.get("parameters", {}).items()},
+                "correlation": {"names": final.posterior.get("names"), "matrix": final.posterior.get("correlation")},
+                "similarity": self.similarity, "separating_condition": self.separating,
+                "groups": self.groups, "residuals_before": self.residual_table(False),
+                "residuals_after": self.residual_table(True) if self.after is not None else None,
+                "notes": self.notes}
+
+
+def _score(model: Model, fit: Fit, parameter: str) -> tuple[float, float, np.ndarray]:
+    """(S, implied step, J_E) of the score test for one net input at the base fit."""
+    w = 1.0 / model.sigma ** 2
+    r = model.y - model.predict(fit.best)
+    jt = model.jacobian(fit.best)
+    je = model.net_jacobian(fit.best, parameter)
+    wj = jt * w[:, None]
+    a = jt.T @ wj + 1e-12 * np.eye(jt.shape[1])
+    mje = w * je - wj @ np.linalg.solve(a, wj.T @ je)
+    info = float(je @ mje)
+    u = float(mje @ r)  # J_E' M r: the score with the base parameters re-adjusted
+    if info <= 0:
+        return 0.0, 0.0, mje
+    return u * u / info, u / info, mje
+
+
+def _cosine(a: np.ndarray, b: np.ndarray, model: Model) -> float:
+    """Cosine between projected signatures in the metric W^-1 (a, b are M J)."""
+    s2 = model.sigma ** 2
+    num = float(a @ (s2 * b))
+    den = float(np.sqrt((a @ (s2 * a)) * (b @ (s2 * b))))
+    return abs(num) / den if den > 0 else 0.0
+
+
+def _condition_key(o: Observation) -> str:
+    """The condition group of an observation (the shear fraction is a point of one test, not a test)."""
+    items = [(k, v) for k, v in o.conditions.items() if k != "shear_fraction"]
+    return ", ".join(f"{k}={v:g}" for k, v in items) if items else ""
+
+
+def _loco(observations, nets, ranges, candidates, free: Candidate | None) -> float:
+    """Leave one condition group out: fit on the others, predict the group; RMSE of relative errors."""
+    keys = sorted({_condition_key(o) for o in observations} - {""})
+    if len(keys) < 2:
+        return float("nan")
+    errs = []
+    for key in keys:
+        train = [o for o in observations if _condition_key(o) != key]
+        test = [o for o in observations if _condition_key(o) == key]
+        m = Model(train, nets, ranges, candidates, free)
+        f = minimise(m, starts=1024, keep=3)
+        mt = Model(test, nets, ranges, candidates, free)
+        errs += list((mt.y - mt.predict(f.best)) / mt.y)
+    return float(np.sqrt(np.mean(np.square(errs))))
+
+
+def _separating(obs_pool: list[Observation], nets, ranges, candidates, a: CandidateResult, b: CandidateResult):
+    """Among hypothetical observations, the one where the two explanations differ most (in units of
+    the surrogate's scatter)."""
+    best = None
+    for o in obs_pool:
+        ma = Model([o], nets, ranges, candidates, next(c for c in candidates if c.parameter == a.parameter))
+        mb = Model([o], nets, ranges, candidates, next(c for c in candidates if c.parameter == b.parameter))
+        d = abs(float(ma.predict(a.fit.best)[0] - mb.predict(b.fit.best)[0])) / ma.sigma[0]
+        if best is None or d > best[0]:
+            best = (d, o)
+    if best is None:
+        return None
+    return {"quantity": best[1].quantity.key, "conditions": best[1].conditions, "difference_in_sigma": best[0]}
+
+
+def hypothetical_observations(nets: dict) -> list[Observation]:
+    """A grid of test conditions the stores cover: where a new measurement could be made."""
+    out = []
+    for q, net in nets.items():
+        grids = []
+        for cname in q.conditions:
+            j = net.input_names.index(cname)
+            lo, hi = net.lo[j], net.hi[j]
+            grids.append((cname, np.geomspace(lo, hi, 4) if cname == "preshear_stress" else np.linspace(lo, hi, 4)))
+        combos = [{}]
+        for cname, vals in grids:
+            combos = [dict(c, **{cname: float(v)}) for c in combos for v in vals]
+        for c in combos:
+            out.append(Observation(q, c, 1.0, 0.0, f"{q.key} " + ", ".join(f"{k}={v:.3g}" for k, v in c.items())))
+    return out
+
+
+def diagnose(material: str, observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate],
+             say=print) -> Diagnosis:
+    used = {o.quantity for o in observations}
+    inputs = set().union(*(set(nets[q].input_names) for q in used))
+    covered = [c for c in candidates if c.parameter in inputs and c.parameter in ranges]
+    not_covered = [c.name for c in candidates if c not in covered]
+    notes = []
+    n = len(observations)
+    base_model = Model(observations, nets, ranges, covered)
+    if n <= len(base_model.free):
+        raise ValueError(f"{n} usable measurements for {len(base_model.free)} base parameters: nothing to test")
+    base = minimise(base_model)
+    base.posterior = posterior(base_model, base)
+    say(f"  base model: chi^2/dof {base.chi2_per_dof:.2f} (p = {base.p_value:.2g}, {n} rows)")
+    results, mjs = [], {}
+    for c in covered:
+        s, step, mje = _score(base_model, base, c.parameter)
+        mjs[c.name] = mje
+        m = Model(observations, nets, ranges, covered, c)
+        f = minimise(m, start=np.append(base.best, c.neutral_value(base.as_dict())))
+        lr = max(base.chi2 - f.chi2, 0.0)
+        neutral = c.neutral_value(base.as_dict())
+        p = float(stats.chi2.sf(lr, 1))
+        if c.side == "+":
+            p = 0.5 * p if f.best[-1] > neutral else 1.0
+        res = CandidateResult(c.name, c.parameter, c.unit, c.side, neutral, float(s), float(step), float(lr), p,
+                              float(f.bic - base.bic), float(f.best[-1]), fit=f)
+        results.append(res)
+        say(f"  {c.name:16s} LR {lr:8.2f}  p {p:9.2g}  dBIC {res.delta_bic:8.2f}  score {s:8.2f}  "
+            f"estimate {res.estimate:.4g} {c.unit}")
+    results.sort(key=lambda r: (-r.statistic, r.effect))
+    similarity = {}
+    for i, a in enumerate(results):
+        for b in results[i + 1:]:
+            similarity[f"{a.effect}|{b.effect}"] = _cosine(mjs[a.effect], mjs[b.effect], base_model)
+    sig = [r for r in results if r.p_value < ALPHA]
+    after = after_model = None
+    separating = {}
+    chosen = None
+    if not sig:
+        verdict = "no_effect_needed" if base.p_value >= ACCEPT else "unexplained"
+    else:
+        chosen = sig[0]
+        tied = [r for r in sig[1:] if chosen.statistic - r.statistic < DELTA_TIE]
+        verdict = "indistinguishable" if tied else "effect"
+        pool = hypothetical_observations({q: nets[q] for q in nets if q.rig in {o.quantity.rig for o in observations}})
+        for r in tied:
+            separating[f"{chosen.effect}|{r.effect}"] = _separating(pool, nets, ranges, covered, chosen, r)
+    if chosen is not None:
+        cand = next(c for c in covered if c.parameter == chosen.parameter)
+        after_model = Model(observations, nets, ranges, covered, cand)
+        after = chosen.fit
+        after.posterior = posterior(after_model, after)
+        p = after.posterior["parameters"][cand.parameter]
+        chosen.estimate_lo, chosen.estimate_hi = p["lo"], p["hi"]
+        if after.p_value < ACCEPT:
+            notes.append(f"adding {chosen.effect} lowers chi^2/dof from {base.chi2_per_dof:.2f} to "
+                         f"{after.chi2_per_dof:.2f}, but the fit is still rejected (p = {after.p_value:.2g})")
+            verdict = "unexplained"
+    loco = {"before": _loco(observations, nets, ranges, covered, None)}
+    if chosen is not None:
+        loco["after"] = _loco(observations, nets, ranges, covered, next(c for c in covered if c.parameter == chosen.parameter))
+    groups = []
+    for key in sorted({_condition_key(o) for o in observations} - {""}):
+        rows = [o for o in observations if _condition_key(o) == key]
+        if len(rows) < 2:
+            continue
+        m = Model(rows, nets, ranges, covered)
+        f = minimise(m, starts=1024, keep=3)
+        groups.append({"condition": key, "rows": len(rows), "estimate": f.as_dict(), "chi2": f.chi2})
+    for name, p in base.posterior["parameters"].items():
+        if p["at_edge"]:
+            notes.append(f"base model: {name} sits at the edge of its campaign range "
+                         f"[{p['range'][0]:g}, {p['range'][1]:g}] (estimate {p['estimate']:.4g}, 95 % interval "
+                         f"{p['lo']:.4g}-{p['hi']:.4g})")
+    for o in observations:
+        if o.assumed:
+            notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
+    return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
+                     chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
+                     after, after_model, similarity, separating, groups, loco, notes)

@@ -1,0 +1,184 @@
+"""Fitting the surrogates to observations: the model y_k = f_q(theta, eta, x_k) + noise with
+variance max(u_k, s_q)^2 + e_q^2 (u_k the row's stated uncertainty, s_q the rig's seed-to-seed
+scatter, e_q the net's own error: QuantityNet.row_sigma), chi^2 minimisation in the campaign box, and the
+posterior for a uniform prior on that box by importance sampling.
+
+`Model` maps a vector of free parameters (the base parameters, plus at most a candidate's) to
+the nets' inputs: a candidate that is not free sits at its neutral value, which may follow the
+base parameters (wall friction = particle friction); that map is affine, so Jacobians are the
+nets' gradients times its matrix."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize, stats
+from scipy.stats import qmc
+
+from .candidates import BASE_PARAMETERS, Candidate
+from .quantities import Observation
+
+
+class Model:
+    def __init__(self, observations: list[Observation], nets: dict, ranges: dict[str, tuple[float, float]],
+                 candidates: list[Candidate], free_candidate: Candidate | None = None):
+        self.obs = observations
+        self.nets = [nets[o.quantity] for o in observations]
+        self.candidates = {c.parameter: c for c in candidates}
+        self.free = list(BASE_PARAMETERS) + ([free_candidate.parameter] if free_candidate else [])
+        self.free_candidate = free_candidate
+        self.lo = np.array([ranges[n][0] for n in self.free])
+        self.hi = np.array([ranges[n][1] for n in self.free])
+        self.y = np.array([o.value for o in observations])
+        self.sigma = np.array([n.row_sigma(o.uncertainty) for o, n in zip(observations, self.nets)])
+        self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
+
+    def _inputs_of(self, o: Observation, net, p: np.ndarray) -> np.ndarray:
+        theta = dict(zip(self.free, p))
+        row = []
+        for name in net.input_names:
+            if name in theta:
+                row.append(theta[name])
+            elif name in o.conditions:
+                row.append(o.conditions[name])
+            elif name in self.candidates:
+                row.append(self.candidates[name].neutral_value(theta))
+            else:
+                raise ValueError(f"{net.quantity.key}: the surrogate's input {name!r} is neither a base parameter, a "
+                                 f"candidate effect nor a condition of {o.label}")
+        return np.array(row, dtype=float)
+
+    def _affine_map(self, o, net):
+        """inputs = c + A p (the neutral values are affine in the base parameters)."""
+        k = len(self.free)
+        c = self._inputs_of(o, net, np.zeros(k))
+        a = np.column_stack([self._inputs_of(o, net, np.eye(k)[j]) - c for j in range(k)]) if k else np.zeros((len(c), 0))
+        return c, a
+
+    def predict(self, p: np.ndarray) -> np.ndarray:
+        """p: (m, k) or (k,) -> predictions (m, n) or (n,)."""
+        p2 = np.atleast_2d(p)
+        out = np.column_stack([net(c + p2 @ a.T) for net, (c, a) in zip(self.nets, self._maps)])
+        return out[0] if np.ndim(p) == 1 else out
+
+    def jacobian(self, p: np.ndarray) -> np.ndarray:
+        """(n, k): d prediction / d free parameters at p."""
+        rows = []
+        for net, (c, a) in zip(self.nets, self._maps):
+            rows.append(net.gradient((c + a @ p)[None, :])[0] @ a)
+        return np.array(rows)
+
+    def net_jacobian(self, p: np.ndarray, parameter: str) -> np.ndarray:
+        """(n,): d prediction / d (net input `parameter`) at p, the other inputs held (a
+        candidate's signature at the base model)."""
+        out = []
+        for net, (c, a) in zip(self.nets, self._maps):
+            g = net.gradient((c + a @ p)[None, :])[0]
+            out.append(g[net.input_names.index(parameter)] if parameter in net.input_names else 0.0)
+        return np.array(out)
+
+    def residuals(self, p):
+        return (self.y - self.predict(p)) / self.sigma
+
+    def chi2(self, p) -> np.ndarray:
+        r = (self.y - self.predict(np.atleast_2d(p))) / self.sigma
+        return np.sum(r * r, axis=1)
+
+
+@dataclass
+class Fit:
+    names: list[str]
+    best: np.ndarray
+    chi2: float
+    n: int
+    lo: np.ndarray
+    hi: np.ndarray
+    posterior: dict = field(default_factory=dict)
+
+    @property
+    def dof(self) -> int:
+        return max(self.n - len(self.names), 1)
+
+    @property
+    def chi2_per_dof(self) -> float:
+        return self.chi2 / self.dof
+
+    @property
+    def p_value(self) -> float:
+        return float(stats.chi2.sf(self.chi2, self.dof))
+
+    @property
+    def bic(self) -> float:
+        return self.chi2 + len(self.names) * np.log(self.n)
+
+    def as_dict(self) -> dict:
+        return dict(zip(self.names, map(float, self.best)))
+
+
+def minimise(model: Model, starts: int = 4096, keep: int = 6, seed: int = 0, start: np.ndarray | None = None) -> Fit:
+    """chi^2 minimum in the box: a scrambled Sobol scan, then bounded least squares (analytic
+    Jacobian) from the best few points and from `start` (a nested model's optimum: the larger
+    model then never fits worse than the smaller one)."""
+    k = len(model.free)
+    pts = qmc.scale(qmc.Sobol(k, scramble=True, seed=seed).random(starts), model.lo, model.hi)
+    c2 = model.chi2(pts)
+    order = list(np.argsort(c2)[:keep])
+    if start is not None:
+        pts = np.vstack([pts, np.clip(start, model.lo, model.hi)])
+        order.append(len(pts) - 1)
+    best_p, best_c = None, np.inf
+    width = model.hi - model.lo
+    for i in order:
+        res = optimize.least_squares(lambda u: model.residuals(model.lo + u * width), (pts[i] - model.lo) / width,
+                                     jac=lambda u: -model.jacobian(model.lo + u * width) * width / model.sigma[:, None],
+                                     bounds=(0.0, 1.0), method="trf", x_scale=1.0, max_nfev=200)
+        p = model.lo + res.x * width
+        c = float(model.chi2(p)[0])
+        if c < best_c:
+            best_p, best_c = p, c
+    return Fit(list(model.free), best_p, best_c, len(model.y), model.lo, model.hi)
+
+
+def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edge: float = 0.01) -> dict:
+    """Posterior of the free parameters for a uniform prior on the box: importance sampling
+    from a mixture of the uniform prior and a Gaussian at the best fit (covariance 4x the
+    Laplace one, so the tails are covered). Weighted mean, 95 % credible intervals,
+    correlations, effective sample size, and the parameters whose estimate or interval
+    reaches a range edge (within `edge` of the width)."""
+    k = len(fit.names)
+    rng = np.random.default_rng(seed)
+    lo, hi = fit.lo, fit.hi
+    width = hi - lo
+    J = model.jacobian(fit.best) / model.sigma[:, None]
+    info = J.T @ J + np.diag(1e-9 / width ** 2)
+    cov = 4.0 * np.linalg.inv(info)
+    half = samples // 2
+    uni = qmc.scale(qmc.Sobol(k, scramble=True, seed=seed).random(half), lo, hi)
+    gau = rng.multivariate_normal(fit.best, cov, size=samples - half, method="cholesky")
+    gau = gau[np.all((gau >= lo) & (gau <= hi), axis=1)]
+    x = np.vstack([uni, gau])
+    log_like = -0.5 * model.chi2(x)
+    inv = np.linalg.inv(cov)
+    d = x - fit.best
+    log_g = -0.5 * np.einsum("ij,jk,ik->i", d, inv, d) - 0.5 * np.linalg.slogdet(2 * np.pi * cov)[1]
+    log_u = -np.sum(np.log(width))
+    log_q = np.logaddexp(np.log(half / len(x)) + log_u, np.log((len(x) - half) / len(x)) + log_g)
+    lw = log_like + log_u - log_q
+    w = np.exp(lw - lw.max())
+    w /= w.sum()
+    ess = float(1.0 / np.sum(w * w))
+    mean = w @ x
+    var = w @ (x - mean) ** 2
+    sd = np.sqrt(var)
+    cov_p = ((x - mean) * w[:, None]).T @ (x - mean)
+    corr = cov_p / np.outer(sd, sd)
+    out = {"samples": int(len(x)), "ess": ess, "parameters": {}, "correlation": corr.tolist(), "names": fit.names}
+    for j, name in enumerate(fit.names):
+        order = np.argsort(x[:, j])
+        cw = np.cumsum(w[order])
+        q025, q975 = (float(x[order[min(np.searchsorted(cw, q), len(cw) - 1)], j]) for q in (0.025, 0.975))
+        at_edge = bool(min(fit.best[j] - lo[j], hi[j] - fit.best[j]) < edge * width[j]
+                       or q025 - lo[j] < edge * width[j] or hi[j] - q975 < edge * width[j])
+        out["parameters"][name] = {"estimate": float(fit.best[j]), "mean": float(mean[j]), "sd": float(sd[j]),
+                                   "lo": q025, "hi": q975, "range": [float(lo[j]), float(hi[j])], "at_edge": at_edge}
+    return out

@@ -1,0 +1,135 @@
+"""One name for a calibrated quantity: (rig, metric) plus the test conditions it is measured at.
+
+A measurement row becomes an Observation: its Quantity, the values of the conditions the
+surrogate takes as inputs (pre-shear stress and shear fraction for the ring shear, slot width
+for the hopper), value and standard uncertainty. A campaign store becomes one training table
+per Quantity: inputs = the store's varied parameters followed by the quantity's conditions
+that the store does not vary itself (the shear fraction: one run measures several)."""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..measurements import Measurement
+
+# conditions each rig's surrogates take as inputs, in SI units, and how measurement files name them
+CONDITIONS = {"ring-shear": ("preshear_stress", "shear_fraction"), "aor": (), "hopper": ("slot_width",)}
+CONDITION_UNITS = {"preshear_stress": "Pa", "shear_fraction": "", "slot_width": "m"}
+# quantities a measurement file may name, per rig, and the conditions each one depends on
+QUANTITIES = {
+    "ring-shear": {"mu_ie_ps": ("preshear_stress",), "mu_ie_s": ("preshear_stress", "shear_fraction"),
+                   "bulk_density": ("preshear_stress",)},
+    "aor": {"angle_of_repose": (), "bulk_density": ()},
+    "hopper": {"mass_flow_rate": ("slot_width",), "discharge_time": ("slot_width",), "bulk_density": ("slot_width",)},
+}
+_FRACTION_METRIC = re.compile(r"^mu_ie_s_(\d+)$")
+
+
+@dataclass(frozen=True)
+class Quantity:
+    rig: str
+    metric: str
+
+    @property
+    def key(self) -> str:
+        return f"{self.rig}:{self.metric}"
+
+    @property
+    def conditions(self) -> tuple[str, ...]:
+        return QUANTITIES[self.rig][self.metric]
+
+
+@dataclass
+class Observation:
+    quantity: Quantity
+    conditions: dict[str, float]  # every condition the quantity depends on, SI
+    value: float
+    uncertainty: float            # the measurement's own standard uncertainty
+    label: str
+    assumed: dict[str, float] = field(default_factory=dict)  # conditions the file did not give
+
+    def condition_text(self) -> str:
+        return ", ".join(f"{k}={v:g}" + (" (assumed)" if k in self.assumed else "") for k, v in self.conditions.items())
+
+
+class ObservationError(ValueError):
+    """A measurement that the surrogates cannot represent (named with its line)."""
+
+
+def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
+    """The Observation of a measurement row; a condition the row does not give (or gives as
+    `unknown`) takes the campaign preset's value from `defaults` and is marked assumed."""
+    rig = m.rig
+    if rig not in QUANTITIES or m.quantity not in QUANTITIES[rig]:
+        offered = "; ".join(f"{r}: {', '.join(q)}" for r, q in QUANTITIES.items())
+        raise ObservationError(f"line {m.line}: {m.label}: no surrogate quantity for test {m.test!r} quantity "
+                               f"{m.quantity!r} (the diagnosis knows {offered})")
+    q = Quantity(rig, m.quantity)
+    cond, assumed = {}, {}
+    for name in q.conditions:
+        text = m.conditions.get(name, "unknown")
+        if text.lower() in ("unknown", ""):
+            if name not in defaults:
+                raise ObservationError(f"line {m.line}: {m.label}: condition {name} is not given and has no default")
+            cond[name] = assumed[name] = float(defaults[name])
+            continue
+        try:
+            cond[name] = float(text)
+        except ValueError:
+            raise ObservationError(f"line {m.line}: {m.label}: condition {name}={text!r} is not a number "
+                                   f"(in {CONDITION_UNITS[name] or 'a fraction'})") from None
+    if not math.isfinite(m.uncertainty):
+        raise ObservationError(f"line {m.line}: {m.label}: no uncertainty given; the likelihood needs one")
+    return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed)
+
+
+def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
+    """{Quantity: (input names, inputs, values)} over the store's finished runs. Ring-shear
+    runs give one mu_ie_s row per shear point, the fraction as an extra input."""
+    rig = store.spec.rig
+    names = list(store.spec.names)
+    done = store.status == 1
+    out = {}
+    fixed = {}
+    cfg = store.spec.config({k: 0.5 * (lo + hi) for k, (lo, hi) in store.spec.ranges.items()})
+    for cname in CONDITIONS[rig]:  # a condition the store does not vary is constant: not an input
+        if cname not in names and hasattr(cfg, cname) and cname != "shear_fraction":
+            fixed[cname] = float(getattr(cfg, cname))
+    for metric in QUANTITIES[rig]:
+        q = Quantity(rig, metric)
+        if metric == "mu_ie_s":
+            xs, ys = [], []
+            for j, mname in enumerate(store.metric_names):
+                hit = _FRACTION_METRIC.match(mname)
+                if not hit:
+                    continue
+                ok = done & np.isfinite(store.values[:, j])
+                frac = int(hit.group(1)) / 100.0
+                xs.append(np.column_stack([store.params[ok], np.full(ok.sum(), frac)]))
+                ys.append(store.values[ok, j])
+            if xs:
+                out[q] = (names + ["shear_fraction"], np.vstack(xs), np.concatenate(ys))
+            continue
+        if metric not in store.metric_names:
+            continue
+        j = store.metric_names.index(metric)
+        ok = done & np.isfinite(store.values[:, j])
+        out[q] = (names, store.params[ok], store.values[ok, j])
+    return out
+
+
+def preset_conditions(store) -> dict[str, float]:
+    """The conditions of the store's preset (the defaults for rows that do not give them)."""
+    from ..rigs import RIGS, load
+    cfg = load(RIGS[store.spec.rig][1], store.spec.preset)
+    out = {}
+    for cname in CONDITIONS[store.spec.rig]:
+        if cname == "shear_fraction":
+            continue
+        v = getattr(cfg, cname, None)
+        if v is not None:
+            out[cname] = float(v)
+    return out

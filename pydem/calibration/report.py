@@ -1,0 +1,193 @@
+"""Renders a Diagnosis: `report.html` (self-contained, plots embedded), `report.md` (the same
+tables, plots as PNG files beside it) and `diagnosis.json`. Renders only: every number comes
+from the Diagnosis object."""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .diagnose import ALPHA, Diagnosis
+
+VERDICT_TEXT = {
+    "no_effect_needed": "The base model is consistent with the measurements: no candidate effect is needed.",
+    "effect": "The base model fails; one missing effect explains it: {effect}.",
+    "indistinguishable": "The base model fails; {effect} and {others} explain it about equally well with these conditions.",
+    "unexplained": "The base model fails, and none of the candidate effects explains the misfit.",
+}
+
+
+def _finite(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, (np.floating, np.integer)):
+        return _finite(obj.item())
+    return obj
+
+
+def verdict_line(d: Diagnosis) -> str:
+    sig = [c.effect for c in d.candidates if c.p_value < ALPHA and c.effect != d.effect]
+    return VERDICT_TEXT[d.verdict].format(effect=d.effect, others=", ".join(sig) or "another candidate")
+
+
+def _png(fig) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _axis_condition(q) -> str | None:
+    return {"ring-shear": "preshear_stress", "hopper": "slot_width"}.get(q.rig)
+
+
+def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
+    """Measured (error bars: the row's sigma) and model before/after against each quantity's condition."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    before = d.base_model.predict(d.base.best)
+    after = d.after_model.predict(d.after.best) if d.after is not None else None
+    quantities = sorted({o.quantity for o in d.observations}, key=lambda q: q.key)
+    n = len(quantities)
+    cols = min(3, n)
+    rows = int(math.ceil(n / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.5 * rows), squeeze=False)
+    for ax, q in zip(axes.flat, quantities):
+        idx = [i for i, o in enumerate(d.observations) if o.quantity == q]
+        cname = _axis_condition(q)
+        series = {}
+        for i in idx:
+            o = d.observations[i]
+            key = f"f = {o.conditions['shear_fraction']:g}" if "shear_fraction" in o.conditions else ""
+            series.setdefault(key, []).append(i)
+        for k, (label, ii) in enumerate(sorted(series.items())):
+            x = np.array([d.observations[i].conditions.get(cname, k) if cname else k for i in ii], dtype=float)
+            order = np.argsort(x)
+            x = x[order]
+            ii = [ii[j] for j in order]
+            col = f"C{k}"
+            ax.errorbar(x, [d.observations[i].value for i in ii], yerr=[d.base_model.sigma[i] for i in ii], fmt="o",
+                        color=col, capsize=3, label=f"measured {label}".strip())
+            ax.plot(x, before[ii], "--", color=col, alpha=0.8, label=f"base model {label}".strip())
+            if after is not None:
+                ax.plot(x, after[ii], "-", color=col, label=f"with {d.effect or 'best candidate'} {label}".strip())
+        ax.set_title(q.key, fontsize=10)
+        if cname == "preshear_stress":
+            ax.set_xscale("log")
+        ax.set_xlabel({"preshear_stress": "pre-shear stress (Pa)", "slot_width": "slot width (m)"}.get(cname, ""))
+        ax.legend(fontsize=6)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.suptitle("measured (bars: 1 sigma incl. seed scatter and net error) vs model", fontsize=10)
+    out = {"residuals.png": _png(fig)}
+    fig, ax = plt.subplots(figsize=(5.5, 0.5 + 0.45 * max(len(d.candidates), 1)))
+    names = [c.effect for c in d.candidates][::-1]
+    vals = [c.statistic for c in d.candidates][::-1]
+    from scipy import stats
+    thr = float(stats.chi2.isf(2 * ALPHA, 1))
+    ax.barh(names, vals, color=["C3" if c.p_value < ALPHA else "C0" for c in d.candidates][::-1])
+    ax.axvline(thr, color="k", ls=":", label=f"p = {ALPHA:g} (one-sided)")
+    ax.set_xlabel("profile-likelihood ratio (chi^2 base - chi^2 with the effect)")
+    ax.legend(fontsize=7)
+    if not names:
+        ax.text(0.5, 0.5, "no candidate covered by these campaigns", ha="center", transform=ax.transAxes)
+    out["candidates.png"] = _png(fig)
+    return out
+
+
+def _table(rows: list[list], header: list[str]) -> tuple[str, str]:
+    md = "| " + " | ".join(header) + " |\n|" + "---|" * len(header) + "\n"
+    md += "".join("| " + " | ".join(map(str, r)) + " |\n" for r in rows)
+    h = "<table><tr>" + "".join(f"<th>{html.escape(x)}</th>" for x in header) + "</tr>"
+    h += "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r) + "</tr>" for r in rows) + "</table>"
+    return md, h
+
+
+def _g(x, fmt=".4g"):
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
+
+
+def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    data = d.as_dict()
+    data["context"] = context or {}
+    (out / "diagnosis.json").write_text(json.dumps(_finite(data), indent=1))
+    plots = plot_residuals(d)
+    for name, png in plots.items():
+        (out / name).write_bytes(png)
+    sections = []  # (title, markdown, html)
+    sections.append(("Verdict", f"**{d.verdict}** — {verdict_line(d)}", f"<p class='verdict'><b>{d.verdict}</b> — "
+                     f"{html.escape(verdict_line(d))}</p>"))
+    b, a = data["before"], data["after"]
+    rows = [["base model", _g(b["chi2_per_dof"], ".2f"), b["dof"], _g(b["p_value"], ".2g"), _g(b["rmse_relative"], ".3f"),
+             _g(b["loco_rmse_relative"], ".3f")]]
+    if a:
+        rows.append([f"with {d.effect or (d.candidates[0].effect + ' (not enough)')}", _g(a["chi2_per_dof"], ".2f"), a["dof"],
+                     _g(a["p_value"], ".2g"), _g(a["rmse_relative"], ".3f"), _g(a["loco_rmse_relative"], ".3f")])
+    md, h = _table(rows, ["model", "chi^2/dof", "dof", "p-value", "RMSE of relative residuals",
+                          "leave-one-condition-out RMSE"])
+    sections.append(("Before and after", md, h))
+    rows = [[c.effect, c.parameter, _g(c.statistic, ".2f"), _g(c.p_value, ".2g"), _g(c.delta_bic, ".1f"),
+             _g(c.score, ".2f"), f"{_g(c.estimate)} {c.unit}".strip(), f"{_g(c.neutral)} {c.unit}".strip()]
+            for c in d.candidates]
+    md, h = _table(rows, ["candidate", "parameter", "LR statistic", "p-value", "dBIC", "score", "estimate", "neutral"])
+    extra = ""
+    if d.not_covered:
+        extra = f"\n\nNot covered by these campaigns: {', '.join(d.not_covered)}."
+    sims = "; ".join(f"{k.replace('|', ' vs ')}: {v:.2f}" for k, v in d.similarity.items())
+    if sims:
+        extra += f"\n\nCosine of the candidates' projected signatures (1: these conditions cannot tell them apart): {sims}."
+    for k, s in d.separating.items():
+        if s:
+            extra += (f"\n\n{k.replace('|', ' and ')} are told apart best by measuring {s['quantity']} at "
+                      + ", ".join(f"{kk}={vv:.4g}" for kk, vv in s["conditions"].items())
+                      + f" (the two explanations differ there by {s['difference_in_sigma']:.1f} sigma).")
+    sections.append(("Candidate effects", md + extra, h + "".join(f"<p>{html.escape(x)}</p>" for x in extra.split("\n\n") if x)))
+    params = data["parameters"]
+    rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
+            for k, v in params.items()]
+    md, h = _table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
+    sections.append(("Parameters" + (f" (with {d.effect})" if d.after is not None else ""), md, h))
+    for title, key in (("Residuals, base model", "residuals_before"), ("Residuals, with the effect", "residuals_after")):
+        if not data.get(key):
+            continue
+        rows = [[r["label"], _g(r["measured"]), _g(r["u_measured"], ".3g"), _g(r["model"]), _g(r["sigma"], ".3g"),
+                 _g(r["z"], "+.2f")] for r in data[key]]
+        md, h = _table(rows, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
+        sections.append((title, md, h))
+    if d.groups:
+        names = list(d.groups[0]["estimate"])
+        rows = [[g["condition"], g["rows"]] + [_g(g["estimate"][n], ".3g") for n in names] for g in d.groups]
+        md, h = _table(rows, ["condition group", "rows"] + names)
+        sections.append(("Base model recalibrated per condition group (a parameter drifting with a condition points "
+                         "at a missing effect)", md, h))
+    if d.notes:
+        sections.append(("Notes", "\n".join(f"- {n}" for n in d.notes), "<ul>" + "".join(f"<li>{html.escape(n)}</li>"
+                                                                                        for n in d.notes) + "</ul>"))
+    title = f"Diagnosis: {d.material}"
+    md = f"# {title}\n\n" + "\n\n".join(f"## {t}\n\n{m}" for t, m, _ in sections)
+    md += "\n\n## Plots\n\n![measured vs model](residuals.png)\n\n![candidates](candidates.png)\n"
+    (out / "report.md").write_text(md)
+    imgs = "".join(f"<figure><img alt='{n}' src='data:image/png;base64,{base64.b64encode(p).decode()}'></figure>"
+                   for n, p in plots.items())
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>"
+            "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
+            "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
+            ".verdict{font-size:1.2em;background:#f4f4f0;padding:.6em}img{max-width:100%}</style></head><body>"
+            f"<h1>{html.escape(title)}</h1>" + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[:2])
+            + imgs + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[2:]) + "</body></html>")
+    path = out / "report.html"
+    path.write_text(page)
+    return path

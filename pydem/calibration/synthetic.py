@@ -1,0 +1,246 @@
+"""Pseudo-measurements with a hidden effect, and the validation protocol of the diagnosis
+(issue protocol, docs/diagnosis.md):
+
+- a programme of test conditions: ring shear at three pre-shear stresses with shear points at
+  40/60/80 %, the angle of repose with its bulk density, the hopper at three slot widths;
+- truth: base parameters drawn at random in the campaign box; one candidate effect switched on
+  at a random strength (or none: a null set);
+- each value = the model's value + the rig's seed-to-seed scatter (one run) + lab noise
+  (2 % on friction coefficients, 1 % on bulk density, 0.5 deg on the angle of repose, 2 % on flow
+  rates and discharge times); each row's uncertainty states the noise and the scatter combined.
+
+`surrogate_set` takes the model values from the nets (cheap: hundreds of sets, for the
+false-alarm rate), `dem_set` from real rig runs at the campaign preset (a few sets, to check).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .candidates import BASE_PARAMETERS, Candidate
+from .quantities import Observation, Quantity
+
+NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
+         "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
+
+
+def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6, 0.8), slots=None) -> list[Observation]:
+    """The conditions grid, for the quantities the nets offer (values to be filled in)."""
+    out = []
+    for q in sorted(nets, key=lambda q: q.key):
+        net = nets[q]
+        if q.rig == "ring-shear":
+            for s in preshear:
+                if q.metric == "mu_ie_s":
+                    out += [Observation(q, {"preshear_stress": s, "shear_fraction": f}, math.nan, math.nan,
+                                        f"ring_shear:mu_ie_s (preshear_stress={s:g}, shear_fraction={f:g})") for f in fractions]
+                else:
+                    out.append(Observation(q, {"preshear_stress": s}, math.nan, math.nan,
+                                           f"ring_shear:{q.metric} (preshear_stress={s:g})"))
+        elif q.rig == "hopper":
+            j = net.input_names.index("slot_width")
+            widths = slots or tuple(np.linspace(net.lo[j], net.hi[j], 5)[1:4])
+            for b in widths:
+                out.append(Observation(q, {"slot_width": float(b)}, math.nan, math.nan,
+                                       f"hopper:{q.metric} (slot_width={b:.4g})"))
+        else:
+            out.append(Observation(q, {}, math.nan, math.nan, f"{q.rig}:{q.metric}"))
+    return out
+
+
+def noise_sd(metric: str, value: float) -> float:
+    kind, v = NOISE[metric]
+    return v * abs(value) if kind == "rel" else v
+
+
+@dataclass
+class Truth:
+    theta: dict[str, float]
+    effect: str | None
+    parameter: str | None
+    strength: float | None
+
+    def inputs(self, candidates: list[Candidate]) -> dict[str, float]:
+        """Every net input except the conditions: base parameters, and each candidate at the
+        truth's value (the active one) or its neutral value."""
+        out = dict(self.theta)
+        for c in candidates:
+            out[c.parameter] = self.strength if c.parameter == self.parameter else c.neutral_value(self.theta)
+        return out
+
+
+def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidate], effect: str | None,
+               min_fraction: float = 0.2) -> Truth:
+    """Base parameters uniform in the box; the effect's parameter uniform between
+    `min_fraction` of the way from neutral to the range edge and that edge (a random side for
+    two-sided candidates), so an effect is never drawn vanishingly small."""
+    theta = {n: float(rng.uniform(*ranges[n])) for n in BASE_PARAMETERS}
+    if effect is None:
+        return Truth(theta, None, None, None)
+    c = next(c for c in candidates if c.name == effect)
+    lo, hi = ranges[c.parameter]
+    neutral = c.neutral_value(theta)
+    neutral = min(max(neutral, lo), hi)
+    sides = [+1] if c.side == "+" else [+1, -1]
+    side = sides[int(rng.integers(len(sides)))]
+    edge = hi if side > 0 else lo
+    if abs(edge - neutral) < 1e-12 * max(1.0, abs(edge)):
+        edge = lo if side > 0 else hi
+    strength = float(neutral + (edge - neutral) * rng.uniform(min_fraction, 1.0))
+    return Truth(theta, c.name, c.parameter, strength)
+
+
+def _fill(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator) -> list[Observation]:
+    """values: observation index -> the model value before noise (surrogate mean or one DEM run)."""
+    out = []
+    for i, o in enumerate(obs):
+        v = values[i]
+        n = noise_sd(o.quantity.metric, v)
+        s = nets[o.quantity].scatter
+        s = s if np.isfinite(s) else 0.0
+        out.append(Observation(o.quantity, dict(o.conditions), float(v + rng.normal(0.0, n)), float(math.hypot(n, s)),
+                               o.label))
+    return out
+
+
+def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
+                  obs: list[Observation]) -> list[Observation]:
+    """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
+    inp = truth.inputs(candidates)
+    values = {}
+    for i, o in enumerate(obs):
+        net = nets[o.quantity]
+        x = np.array([[o.conditions.get(n, inp.get(n, math.nan)) for n in net.input_names]])
+        s = net.scatter if np.isfinite(net.scatter) else 0.0
+        values[i] = float(net(x)[0]) + rng.normal(0.0, s)
+    return _fill(obs, values, nets, rng)
+
+
+def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], seed: int, threads: int = 1,
+               say=print) -> dict[int, float]:
+    """One rig run per condition group of `obs` at the stores' presets with the given parameter
+    values (a ring-shear run measures its pre-shear and every shear point): {observation index:
+    value}. An observation whose run failed is missing from the result."""
+    from ..rigs import RIGS
+    import time
+    groups: dict = {}
+    for i, o in enumerate(obs):
+        key = (o.quantity.rig, tuple(sorted((k, v) for k, v in o.conditions.items() if k != "shear_fraction")))
+        groups.setdefault(key, []).append(i)
+    values = {}
+    for g, ((rig, cond), idx) in enumerate(groups.items()):
+        store = stores[rig]
+        point = {k: inputs[k] for k in store.spec.names if k in inputs}
+        point.update({k: v for k, v in cond})
+        cfg = store.spec.config(point)
+        fractions = sorted({obs[i].conditions["shear_fraction"] for i in idx if "shear_fraction" in obs[i].conditions})
+        if fractions:
+            cfg.shear_points = list(fractions)
+        cfg.num_threads = threads
+        t0 = time.perf_counter()
+        try:
+            res = RIGS[rig][0](cfg).run(seed=seed)
+        except Exception as exc:  # a run that fails is reported, the others go on
+            say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)} failed: {exc}")
+            continue
+        say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)}: {time.perf_counter() - t0:.0f} s")
+        for i in idx:
+            o = obs[i]
+            metric = o.quantity.metric
+            if metric == "mu_ie_s":
+                metric = f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
+            if metric in res.metrics and isinstance(res.metrics[metric].value, float):
+                values[i] = float(res.metrics[metric].value)
+    return values
+
+
+def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
+            obs: list[Observation], seed: int, threads: int = 1, say=print) -> list[Observation]:
+    """Pseudo-measurements from rig runs at the stores' presets, then lab noise; rows whose run
+    failed are left out."""
+    values = rig_values(stores, truth.inputs(candidates), obs, seed, threads, say)
+    keep = sorted(values)
+    return _fill([obs[i] for i in keep], {k: values[i] for k, i in enumerate(keep)}, nets, rng)
+
+
+def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):
+    """A measurement file (docs/measurements.md) of a pseudo-measurement set, its truth in comments."""
+    lines = [f"# {note}", f"# truth: {truth.theta}; effect {truth.effect} {truth.parameter} = {truth.strength}",
+             "material,test,quantity,value,uncertainty,unit,conditions,use,source"]
+    test_of = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
+    for o in obs:
+        cond = ";".join(f"{k}={v:.6g}" for k, v in o.conditions.items())
+        lines.append(f"{material},{test_of[o.quantity.rig]},{o.quantity.metric},{o.value:.8g},{o.uncertainty:.6g},,"
+                     f"{cond},calibrate,synthetic")
+    from pathlib import Path
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]:
+    """A discrepancy that no candidate represents: the solid density is `factor` times what the
+    model assumes, which scales every bulk density and mass flow rate and nothing else."""
+    out = []
+    for o in obs:
+        k = factor if o.quantity.metric in ("bulk_density", "mass_flow_rate") else 1.0
+        out.append(Observation(o.quantity, dict(o.conditions), o.value * k, o.uncertainty * k, o.label))
+    return out
+
+
+def score_sets(results: list[dict]) -> dict:
+    """Accuracy, false alarms and error fall over validation results (rows of `validate`)."""
+    by = {}
+    for r in results:
+        by.setdefault(r["kind"], []).append(r)
+    out = {}
+    for kind, rows in sorted(by.items()):
+        n = len(rows)
+        if kind == "null":
+            out[kind] = {"sets": n, "false_alarms": sum(r["verdict"] != "no_effect_needed" for r in rows),
+                         "false_alarm_rate": sum(r["verdict"] != "no_effect_needed" for r in rows) / n}
+        elif kind == "unexplained":
+            out[kind] = {"sets": n, "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})}}
+        else:
+            hit = [r for r in rows if r["effect"] == kind]
+            falls = [r["rmse_after"] / r["rmse_before"] for r in hit if r["rmse_after"] is not None and r["rmse_before"] > 0]
+            out[kind] = {"sets": n, "top1": len(hit), "top1_rate": len(hit) / n,
+                         "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})},
+                         "error_after_over_before_median": float(np.median(falls)) if falls else None,
+                         "chi2_per_dof_after_median": float(np.median([r["chi2_after"] for r in hit])) if hit else None}
+    return out
+
+
+def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surrogate", threads: int = 1,
+             say=print) -> list[dict]:
+    """Runs the protocol: kinds = {"null": n, <candidate name>: n, "unexplained": n}; source
+    "surrogate" or "dem". One row per set: truth, verdict, chosen effect, errors before/after."""
+    from .diagnose import diagnose
+    rng = np.random.default_rng(seed)
+    base_obs = programme(setup.nets)
+    rows = []
+    for kind, n in kinds.items():
+        for k in range(n):
+            effect = None if kind in ("null", "unexplained") else kind
+            truth = draw_truth(rng, setup.ranges, setup.candidates, effect)
+            if source == "dem":
+                obs = dem_set(setup.stores, setup.nets, setup.candidates, truth, rng, base_obs,
+                              seed=int(rng.integers(1 << 30)), threads=threads, say=say)
+            else:
+                obs = surrogate_set(setup.nets, setup.candidates, truth, rng, base_obs)
+            if kind == "unexplained":
+                obs = density_mismatch(obs, 1.25)
+            d = diagnose(f"{kind}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
+            s_before, s_after = d.summary_of(d.base, d.base_model), d.summary_of(d.after, d.after_model)
+            row = {"kind": kind, "set": k, "source": source, "truth": truth.theta, "effect_truth": truth.effect,
+                   "strength": truth.strength, "verdict": d.verdict, "effect": d.effect,
+                   "best_candidate": d.candidates[0].effect if d.candidates else None,
+                   "p_best": d.candidates[0].p_value if d.candidates else None,
+                   "chi2_before": s_before["chi2_per_dof"], "rmse_before": s_before["rmse_relative"],
+                   "chi2_after": s_after["chi2_per_dof"] if s_after else None,
+                   "rmse_after": s_after["rmse_relative"] if s_after else None,
+                   "loco_before": d.loco.get("before"), "loco_after": d.loco.get("after")}
+            rows.append(row)
+            say(f"  {source} {kind:14s} #{k}: {d.verdict:18s} {d.effect or '-':14s} chi2/dof {row['chi2_before']:.2f}"
+                + (f" -> {row['chi2_after']:.2f}" if row["chi2_after"] is not None else ""))
+    return rows

@@ -1,0 +1,70 @@
+"""`pydem diagnose`: where the base model fails against a measurement file, which candidate
+effect is missing, and the error before and after adding it (docs/diagnosis.md).
+
+    pydem diagnose data/measurements/synthetic_cohesive.csv --material synthetic_cohesive --out build/diagnosis
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+
+def add_parser(sub):
+    from .calibration.setup import DEFAULT_STORES
+    p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
+    p.add_argument("measurements", help="measurement file (docs/measurements.md)")
+    p.add_argument("--material", required=True)
+    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
+                   help="diagnosis campaign stores, one per rig (default: the shipped tiny ones)")
+    p.add_argument("--out", default="build/diagnosis")
+    p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
+    p.add_argument("--threads", type=int, default=1, help="OpenMP threads of the confirming runs")
+    p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
+    p.set_defaults(func=main)
+
+
+def main(args) -> int:
+    from .calibration import report
+    from .calibration.diagnose import diagnose
+    from .calibration.quantities import ObservationError
+    from .calibration.setup import load_setup, observations_from_file
+    from .campaign import StoreError
+    from .measurements import MeasurementError
+    t0 = time.perf_counter()
+    say = lambda msg: print(msg, flush=True)  # noqa: E731
+    try:
+        setup = load_setup(args.stores, say, args.retrain)
+        obs, skipped = observations_from_file(args.measurements, args.material, setup)
+    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
+        print(f"pydem diagnose: {exc}", file=sys.stderr)
+        return 2
+    for line in skipped:
+        say(f"  left out: {line}")
+    say(f"diagnosing {args.material}: {len(obs)} measurements, candidates "
+        f"{', '.join(c.name for c in setup.candidates)} (stores: libdem {setup.physics})")
+    try:
+        d = diagnose(args.material, obs, setup.nets, setup.ranges, setup.candidates, say)
+    except ValueError as exc:
+        print(f"pydem diagnose: {exc}", file=sys.stderr)
+        return 2
+    d.notes += [f"left out: {line}" for line in skipped]
+    context = {"measurements": str(args.measurements), "stores": {r: str(s.path) for r, s in setup.stores.items()},
+               "libdem_of_stores": setup.physics}
+    if args.confirm:
+        from .calibration.synthetic import rig_values
+        fit, model = (d.after, d.after_model) if d.after is not None else (d.base, d.base_model)
+        inputs = {}
+        for c in setup.candidates:
+            inputs[c.parameter] = c.neutral_value(fit.as_dict())
+        inputs.update(fit.as_dict())
+        say(f"confirming DEM runs at the final estimate ({len({(o.quantity.rig, str(o.conditions)) for o in obs})} "
+            f"condition groups at most)")
+        values = rig_values(setup.stores, inputs, obs, seed=12345, threads=args.threads, say=say)
+        context["confirm"] = [{"label": obs[i].label, "measured": obs[i].value, "dem": v,
+                               "relative": (obs[i].value - v) / obs[i].value} for i, v in sorted(values.items())]
+        for row in context["confirm"]:
+            say(f"  {row['label']:60s} measured {row['measured']:.4g}  DEM {row['dem']:.4g}  ({100 * row['relative']:+.1f} %)")
+    path = report.write(d, args.out, context)
+    say(f"verdict: {d.verdict}" + (f" ({d.effect})" if d.effect else "") + f" — {report.verdict_line(d)}")
+    say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
+    return 0
