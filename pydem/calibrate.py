@@ -133,6 +133,11 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
         skipped += [m for m, n in usable if n is None]
         usable = [(m, n) for m, n in usable if n is not None]
         stages.append(screening.Stage(rig, [n for _, n in usable], [m for m, _ in usable], window))
+    if not any(st.measurements for st in stages):
+        offered = ", ".join(f"{rig}: {', '.join(property_metrics(rig, st))}" for rig, st in stores.items())
+        rows = ", ".join(m.label for m in meas if m.use == "calibrate") or "none marked use=calibrate"
+        raise ValueError(f"{measurements}: no measurement of {material!r} matches a quantity of the given campaigns "
+                         f"(measurements: {rows}; campaigns offer {offered})")
     _say(f"[3/6] screening {samples:,} combinations (scrambled Sobol) natively, {threads} threads, window ±{100 * window:g} %")
     sc = screening.run(names, ranges, stages, samples, seed=7, threads=threads)
     for st, idx in zip(sc.stages, sc.admissible):

@@ -4,10 +4,15 @@
     glass_microbeads,ring_shear,mu_ie_s,0.45995,0.00867,,shear_fraction=0.5,calibrate,VSB ...
 
 test: ring_shear | aor | hopper | poured (bulk density of a poured fill: the AoR rig's filled
-cylinder); anything else is kept but matched to no rig;
-conditions: `key=value` pairs separated by `;` (pre-shear stress, shear fraction, size cut ...);
-uncertainty: one standard uncertainty, empty when not published; use: `calibrate` (screened
-against) or `compare` (shown in comparisons only). Errors name the file, line and column."""
+cylinder); quantity: one of the test's (QUANTITIES_OF_TEST); unit: the quantity's SI unit (or
+empty for SI) or a known alternative (converted: g/cm^3, kPa, rad, g/s, ...), anything else is
+refused; a value outside the physically possible range is refused (1.55 "kg/m^3" is a
+g/cm^3 number);
+conditions: `key=value` pairs separated by `;` from CONDITION_NAMES; uncertainty: one standard
+uncertainty, empty when not published; use: `calibrate` (screened against) or `compare` (shown
+in comparisons only). A UTF-8 byte-order mark and CRLF line ends (a spreadsheet's CSV) are
+accepted; duplicate rows and physically impossible values are refused. Errors name the file,
+line and column."""
 from __future__ import annotations
 
 import csv
@@ -18,6 +23,23 @@ from pathlib import Path
 COLUMNS = ["material", "test", "quantity", "value", "uncertainty", "unit", "conditions", "use", "source"]
 USES = ("calibrate", "compare")
 RIG_OF_TEST = {"ring_shear": "ring-shear", "aor": "aor", "hopper": "hopper", "poured": "aor"}  # poured: the AoR fill
+
+
+# per test, its quantities: (SI unit, {accepted unit: factor to SI}, physically possible range in SI)
+_COEF = ("", {"": 1.0, "-": 1.0, "1": 1.0}, (0.0, 5.0))
+_DENSITY = ("kg/m^3", {"kg/m^3": 1.0, "kg/m3": 1.0, "kg m-3": 1.0, "g/cm^3": 1000.0, "g/cm3": 1000.0,
+                       "g/ml": 1000.0, "t/m^3": 1000.0, "t/m3": 1000.0}, (10.0, 2.5e4))
+_STRESS = ("Pa", {"pa": 1.0, "kpa": 1000.0}, (0.0, 1e8))
+QUANTITIES_OF_TEST = {
+    "ring_shear": {"mu_ie_ps": _COEF, "mu_ie_s": _COEF, "bulk_density": _DENSITY, "tau_shear": _STRESS,
+                   "tau_preshear": _STRESS},
+    "aor": {"angle_of_repose": ("deg", {"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees": 1.0,
+                                        "rad": 57.29577951308232}, (0.0, 90.0)), "bulk_density": _DENSITY},
+    "poured": {"bulk_density": _DENSITY},
+    "hopper": {"mass_flow_rate": ("kg/s", {"kg/s": 1.0, "g/s": 1e-3, "t/h": 1.0 / 3.6}, (0.0, 1e6)),
+               "discharge_time": ("s", {"s": 1.0, "min": 60.0}, (0.0, 1e7)), "bulk_density": _DENSITY},
+}
+CONDITION_NAMES = ("preshear_stress", "shear_fraction", "slot_width", "size_cut_mm", "mean_diameter_mm")
 
 
 class MeasurementError(ValueError):
@@ -71,7 +93,7 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
     """All rows (or those of one material); raises MeasurementError naming line and column."""
     path = Path(path)
     try:
-        lines = path.read_text().splitlines()
+        lines = path.read_text(encoding="utf-8-sig").splitlines()  # a BOM and CRLF are a spreadsheet's
     except (OSError, UnicodeDecodeError) as exc:
         raise MeasurementError(f"{path}: cannot read ({exc})") from None
     numbered = [(i + 1, ln) for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
@@ -86,7 +108,7 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
     unknown = [c for c in header if c not in COLUMNS]
     if unknown:
         raise MeasurementError(f"{path}:{numbered[0][0]}: unknown column(s) {', '.join(unknown)}")
-    out = []
+    out, seen = [], {}
     for (lineno, _), row in zip(numbered[1:], rows[1:]):
         if len(row) != len(header):
             raise MeasurementError(f"{path}:{lineno}: {len(row)} fields, the header has {len(header)}")
@@ -95,15 +117,34 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
         for col in ("material", "test", "quantity"):
             if not rec[col]:
                 raise MeasurementError(f"{where(col)}: empty")
-        value = _number(rec["value"], where("value"), False)
-        unc = _number(rec["uncertainty"], where("uncertainty"), True)
+        test, quantity = rec["test"], rec["quantity"]
+        if test not in QUANTITIES_OF_TEST:
+            raise MeasurementError(f"{where('test')}: unknown test {test!r} (known: {', '.join(QUANTITIES_OF_TEST)})")
+        if quantity not in QUANTITIES_OF_TEST[test]:
+            raise MeasurementError(f"{where('quantity')}: test {test} has no quantity {quantity!r} "
+                                   f"(known: {', '.join(QUANTITIES_OF_TEST[test])})")
+        si_unit, units, (vmin, vmax) = QUANTITIES_OF_TEST[test][quantity]
+        unit_text = rec.get("unit", "").strip()
+        factor = 1.0 if unit_text == "" else units.get(unit_text, units.get(unit_text.lower()))  # empty: SI
+        if factor is None:
+            raise MeasurementError(f"{where('unit')}: {quantity} in {unit_text!r} is not understood "
+                                   f"(give {si_unit or 'no unit'}; also accepted: {', '.join(u for u in units if u) or 'none'})")
+        value = _number(rec["value"], where("value"), False) * factor
+        unc = _number(rec["uncertainty"], where("uncertainty"), True) * factor
         if unc == unc and unc <= 0:
             raise MeasurementError(f"{where('uncertainty')}: must be positive (or empty when unknown), got {unc:g}")
+        if not vmin <= value <= vmax or (vmin == 0.0 and value == 0.0 and quantity != "angle_of_repose"):
+            u_txt = f" {si_unit}" if si_unit else ""
+            raise MeasurementError(f"{where('value')}: {quantity} = {value:g}{u_txt} is outside the physically "
+                                   f"possible range ({vmin:g}, {vmax:g}]{u_txt}")
         conditions = {}
         for item in filter(None, (s.strip() for s in rec.get("conditions", "").split(";"))):
             if "=" not in item:
                 raise MeasurementError(f"{where('conditions')}: expected key=value, got {item!r}")
             k, v = item.split("=", 1)
+            if k.strip() not in CONDITION_NAMES:
+                raise MeasurementError(f"{where('conditions')}: unknown condition {k.strip()!r} "
+                                       f"(known: {', '.join(CONDITION_NAMES)})")
             conditions[k.strip()] = v.strip()
         if "shear_fraction" in conditions:
             f = _number(conditions["shear_fraction"], where("conditions") + " shear_fraction", False)
@@ -112,8 +153,12 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
         use = rec.get("use", "") or "calibrate"
         if use not in USES:
             raise MeasurementError(f"{where('use')}: {use!r} is not one of {', '.join(USES)}")
-        m = Measurement(rec["material"], rec["test"], rec["quantity"], value, unc, rec.get("unit", ""), conditions, use,
-                        rec.get("source", ""), lineno)
+        m = Measurement(rec["material"], test, quantity, value, unc, si_unit, conditions, use, rec.get("source", ""), lineno)
+        key = (m.material, test, quantity, tuple(sorted(conditions.items())))
+        if key in seen:
+            raise MeasurementError(f"{path}:{lineno}: duplicate of line {seen[key]} (same material, test, quantity "
+                                   f"and conditions)")
+        seen[key] = lineno
         if material is None or m.material == material:
             out.append(m)
     if material is not None and not out:

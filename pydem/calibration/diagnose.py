@@ -175,18 +175,28 @@ def _separating(obs_pool: list[Observation], nets, ranges, candidates, a: Candid
     return {"quantity": best[1].quantity.key, "conditions": best[1].conditions, "difference_in_sigma": best[0]}
 
 
-def hypothetical_observations(nets: dict) -> list[Observation]:
-    """A grid of test conditions the stores cover: where a new measurement could be made."""
+def hypothetical_observations(observations: list[Observation], nets: dict) -> list[Observation]:
+    """Where a new measurement could be made: every observed quantity with each of its conditions
+    swept over the campaign's range (4 values), and every other quantity of the same rigs the
+    stores offer at its observed or middle conditions."""
     out = []
+    rigs = {o.quantity.rig for o in observations}
+    seen = {}
+    for o in observations:
+        seen.setdefault(o.quantity, o.conditions)
     for q, net in nets.items():
-        grids = []
-        for cname in q.conditions:
-            j = net.input_names.index(cname)
-            lo, hi = net.lo[j], net.hi[j]
-            grids.append((cname, np.geomspace(lo, hi, 4) if cname == "preshear_stress" else np.linspace(lo, hi, 4)))
-        combos = [{}]
-        for cname, vals in grids:
-            combos = [dict(c, **{cname: float(v)}) for c in combos for v in vals]
+        if q.rig not in rigs:
+            continue
+        base = dict(seen.get(q, {}))
+        conds = [n for n in net.input_names if n in base or n in q.conditions]
+        for n in conds:
+            j = net.input_names.index(n)
+            base.setdefault(n, float(0.5 * (net.lo[j] + net.hi[j])))
+        combos = [base] if not conds else []
+        for n in conds:
+            j = net.input_names.index(n)
+            grid = np.geomspace(net.lo[j], net.hi[j], 4) if n == "preshear_stress" else np.linspace(net.lo[j], net.hi[j], 4)
+            combos += [dict(base, **{n: float(v)}) for v in grid]
         for c in combos:
             out.append(Observation(q, c, 1.0, 0.0, f"{q.key} " + ", ".join(f"{k}={v:.3g}" for k, v in c.items())))
     return out
@@ -201,22 +211,30 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     notes = []
     n = len(observations)
     base_model = Model(observations, nets, ranges, covered)
-    if n <= len(base_model.free):
-        raise ValueError(f"{n} usable measurements for {len(base_model.free)} base parameters: nothing to test")
+    testable = n > len(base_model.free)
+    if not testable:
+        notes.append(f"{n} usable measurement(s) for {len(base_model.free)} base parameters: the base model is "
+                     f"calibrated, but no candidate effect can be tested (a misfit left at this point means the "
+                     f"measurements cannot be reached inside the campaign box)")
+        covered_for_tests = []
+    else:
+        covered_for_tests = covered
     base = minimise(base_model)
     base.posterior = posterior(base_model, base)
     say(f"  base model: chi^2/dof {base.chi2_per_dof:.2f} (p = {base.p_value:.2g}, {n} rows)")
     results, mjs = [], {}
-    for c in covered:
+    for c in covered_for_tests:
         s, step, mje = _score(base_model, base, c.parameter)
+        if c.side == "+" and step < 0:  # one-sided: a step to unphysical values scores nothing
+            s = 0.0
         mjs[c.name] = mje
         m = Model(observations, nets, ranges, covered, c)
         f = minimise(m, start=np.append(base.best, c.neutral_value(base.as_dict())))
         lr = max(base.chi2 - f.chi2, 0.0)
         neutral = c.neutral_value(base.as_dict())
         p = float(stats.chi2.sf(lr, 1))
-        if c.side == "+":
-            p = 0.5 * p if f.best[-1] > neutral else 1.0
+        if c.side == "+":  # P(T >= t) of the 50:50 mixture of 0 and chi^2_1: 1 at t = 0
+            p = 0.5 * p if lr > 1e-9 and f.best[-1] > neutral else 1.0
         res = CandidateResult(c.name, c.parameter, c.unit, c.side, neutral, float(s), float(step), float(lr), p,
                               float(f.bic - base.bic), float(f.best[-1]), fit=f)
         results.append(res)
@@ -237,7 +255,7 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         chosen = sig[0]
         tied = [r for r in sig[1:] if chosen.statistic - r.statistic < DELTA_TIE]
         verdict = "indistinguishable" if tied else "effect"
-        pool = hypothetical_observations({q: nets[q] for q in nets if q.rig in {o.quantity.rig for o in observations}})
+        pool = hypothetical_observations(observations, nets)
         for r in tied:
             separating[f"{chosen.effect}|{r.effect}"] = _separating(pool, nets, ranges, covered, chosen, r)
     if chosen is not None:

@@ -1,0 +1,16 @@
+#!/bin/sh
+# Runs (or resumes) the diagnosis campaigns in data/campaigns/ one after the other: each store is
+# created on the first call and continued on every later one; finished runs are never redone.
+#   sh scripts/diagnosis_campaigns.sh tiny            # the CI stores (~15 min on 2 cores)
+#   sh scripts/diagnosis_campaigns.sh default [N]     # the shipped stores (hours; N workers, default 1)
+set -e
+cd "$(dirname "$0")/.."
+preset=${1:-tiny}
+workers=${2:-2}
+for rig in hopper aor ring_shear; do
+    for kind in "" _replicates; do
+        name=diag_${rig}_${preset}${kind}
+        echo "== $name"
+        .venv/bin/pydem campaign run data/campaigns/$name.toml --store data/campaigns/$name.h5 --workers "$workers"
+    done
+done
