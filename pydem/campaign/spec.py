@@ -9,7 +9,7 @@ parameters under study + a seeded space-filling design. Written as TOML by users
     replicates = 1              # runs per design point (different seeds); nets fit the means
     [set]                       # fixed keys, as `pydem rig --set` takes them
     num_threads = 1
-    "effects.cohesion_sjkr.energy_density" = 2e4
+    "effects.cohesion_sjkr.cohesion_energy_density" = 2e4
     [ranges]                    # parameter = [low, high]
     friction = [0.05, 1.0]
     rolling_friction = [0.0, 0.6]

@@ -55,11 +55,17 @@ def _coerce(value: Any, default: Any, key: str):
             raise ConfigError(f"{key}: expected true/false, got {value!r}")
         return bool(value)
     if isinstance(default, (int, float)) and not isinstance(default, bool):
+        if isinstance(value, bool):  # TOML `true` is not 1.0
+            raise ConfigError(f"{key}: expected a number, got {value!r}")
         try:
             v = float(value)
         except (TypeError, ValueError):
             raise ConfigError(f"{key}: expected a number, got {value!r}") from None
-        return int(v) if isinstance(default, int) and float(v).is_integer() else v
+        if isinstance(default, int):
+            if not v.is_integer():
+                raise ConfigError(f"{key}: expected a whole number, got {value!r}")
+            return int(v)
+        return v
     if isinstance(default, (list, tuple)):
         if isinstance(value, str):
             value = [x for x in value.replace("[", "").replace("]", "").split(",") if x.strip()]
@@ -134,6 +140,25 @@ def load(cls, preset: str = "default", path: str | Path | None = None, overrides
     """A rig config: the preset, then the TOML file's keys (top level and [params],
     [effects.<name>] tables), then `key=value` overrides; validated."""
     cfg = _preset(cls, preset)
+    explicit: dict[str, str] = {}  # key -> where it was given
+
+    def apply(key, value, where):
+        """set_value, refusing a key (such as the hopper's `case`) that would silently overwrite keys
+        given before it."""
+        before = {n: getattr(cfg, n) for n in _fields(cfg) if n != "params"} | \
+                 {f"params.{n}": getattr(cfg.params, n) for n in _fields(cfg.params)}
+        set_value(cfg, key, value)
+        after = {n: getattr(cfg, n) for n in _fields(cfg) if n != "params"} | \
+                {f"params.{n}": getattr(cfg.params, n) for n in _fields(cfg.params)}
+        name = key.split(".")[-1]
+        clobbered = [k for k in after if after[k] != before[k] and k.split(".")[-1] != name
+                     and k.split(".")[-1] in explicit]
+        if clobbered:
+            k = clobbered[0].split(".")[-1]
+            raise ConfigError(f"{key}={value} sets {k} = {after[clobbered[0]]!r}, overriding {k} given before it "
+                              f"({explicit[k]}); give {key} first, then the keys that change it")
+        explicit[name] = where
+
     if path is not None:
         try:
             data = tomllib.loads(Path(path).read_text())
@@ -148,14 +173,14 @@ def load(cls, preset: str = "default", path: str | Path | None = None, overrides
                         for k3, v3 in v2.items():
                             set_value(cfg, f"effects.{k2}.{k3}", v3)
                     else:
-                        set_value(cfg, f"params.{k2}", v2)
+                        apply(f"params.{k2}", v2, str(path))
             else:
-                set_value(cfg, key, value)
+                apply(key, value, str(path))
     for item in overrides or []:
         if "=" not in item:
             raise ConfigError(f"--set expects key=value, got {item!r}")
         k, v = item.split("=", 1)
-        set_value(cfg, k.strip(), v.strip())
+        apply(k.strip(), v.strip(), f"--set {item}")
     validate(cfg)
     return cfg
 
