@@ -31,6 +31,7 @@ class ProgressLine:
         eta = (planned - sim_time) / rate if rate > 0 and planned > sim_time else 0.0
         self.stream.write(f"\r  t = {sim_time:7.3f} s of <= {planned:.2f} s   {rate:8.4f} s/s   "
                           f"{info.get('steps', 0) / wall / 1e3:7.1f} k steps/s   {info.get('particles', 0)} particles   "
+                          f"{info.get('threads', 1)} thread(s)   "
                           f"ETA <= {eta:6.0f} s ")
         self.stream.flush()
 

@@ -18,7 +18,7 @@ import numpy as np
 from .. import geometry
 from .common import (Stepper, frame, lattice_fill, make_domain, params_from, size_distribution, stable_dt,
                      translational_energy_per_particle)
-from .config import Params, knob
+from .config import Params, default_threads, knob
 from .result import Metric, RigResult, block_average
 
 
@@ -34,7 +34,7 @@ class AorConfig:
     lift_speed: float = knob(0.05, 1e-4, 1.0, "m/s", "cylinder lifting speed")
     rest_energy: float = knob(1e-5, 1e-9, 1.0, "", "at rest when translational kinetic energy per sphere < this x m g d")
     max_time: float = knob(6.0, 0.05, 600.0, "s", "simulated time limit")
-    num_threads: int = knob(2, 1, 256, "", "OpenMP threads")
+    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between PNG frames (with --frames)")
     params: Params = field(default_factory=Params)
 

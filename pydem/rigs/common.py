@@ -104,7 +104,7 @@ class Stepper:
             done += k
             self.steps += k
             if self.progress is not None:
-                self.progress(self.d.time, self.planned, {"steps": self.steps, "particles": len(self.d),
+                self.progress(self.d.time, self.planned, {"steps": self.steps, "particles": len(self.d), "threads": self.d.num_threads,
                                                           "wall": time.perf_counter() - self.t_wall0})
             if each is not None and each():
                 return True

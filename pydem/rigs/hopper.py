@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import geometry
 from .common import Stepper, frame, make_domain, params_from, stable_dt, translational_energy_per_particle
-from .config import Params, knob
+from .config import Params, default_threads, knob
 from .result import Metric, RigResult
 
 # seed 001, Table 1: N, nu, E (GPa), fine volume fraction, e_pp, e_wp, mu_pp, mu_wp, mu_r, d (mm), rho
@@ -71,7 +71,7 @@ class HopperConfig:
     settle_time: float = knob(0.4, 0.0, 60.0, "s", "settling after the last filling batch")
     max_time: float = knob(30.0, 0.1, 3600.0, "s", "discharge time limit")
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")
-    num_threads: int = knob(2, 1, 256, "", "OpenMP threads")
+    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between frames (with --frames)")
     frame_width: int = knob(420, 16, 8192, "px", "frame width")
     frame_height: int = knob(230, 16, 8192, "px", "frame height")
