@@ -71,6 +71,14 @@ def main(argv: list[str] | None = None) -> int:
         for key, value, unit, doc in describe(cfg):
             print(f"{key:28s} {value!s:>14} {unit:8s} {doc}")
         return 0
+    try:  # before the run, not after it: a bad path must not cost a finished run
+        if args.out:
+            check_writable(args.out, directory=False)
+        if args.frames:
+            check_writable(args.frames, directory=True)
+    except OSError as exc:
+        print(f"pydem: cannot write the output: {exc}", file=sys.stderr)
+        return 2
     progress = None if args.quiet else ProgressLine()
     try:
         result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress)
@@ -79,13 +87,40 @@ def main(argv: list[str] | None = None) -> int:
             progress.done()
         print(f"pydem: the run failed: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        if progress:
+            progress.done()
+        print("pydem: interrupted (frames written so far are kept)", file=sys.stderr)
+        return 130
     if progress:
         progress.done()
+    from .provenance import provenance
+    result.provenance = provenance() | {"rig": args.name, "preset": args.preset, "seed": args.seed,
+                                        "config": {k: v if isinstance(v, (int, float, str, bool)) else str(v)
+                                                   for k, v, _, _ in describe(cfg)}}
     print(result.summary())
     if args.out:
-        result.save(args.out)
+        try:
+            result.save(args.out)
+        except OSError as exc:
+            print(f"pydem: cannot write {args.out}: {exc}", file=sys.stderr)
+            return 2
         print(f"result written to {args.out}")
     return 0
+
+
+def check_writable(path: str, directory: bool):
+    """Raises OSError naming the path when it cannot be written (a directory is created)."""
+    import os
+    from pathlib import Path
+    p = Path(path)
+    d = p if directory else (p.parent if str(p.parent) else Path("."))
+    if directory:
+        p.mkdir(parents=True, exist_ok=True)
+    if not d.is_dir():
+        raise OSError(f"{d}: no such directory")
+    if not os.access(d, os.W_OK) or (p.exists() and not directory and not os.access(p, os.W_OK)):
+        raise OSError(f"{path}: permission denied")
 
 
 if __name__ == "__main__":

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import platform
-import subprocess
 import sys
 import time
 import traceback
@@ -13,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..provenance import provenance
 from ..rigs import RIGS
 from .design import design_points
 from .spec import CampaignSpec
@@ -41,23 +40,6 @@ def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
 
 def sample_seed(campaign_seed: int, index: int) -> int:
     return int(np.random.SeedSequence([campaign_seed, index]).generate_state(1)[0])
-
-
-def provenance() -> dict:
-    from .. import LIBDEM_VERSION, __version__
-    root = Path(__file__).resolve().parents[2]
-    commit = "unknown"
-    try:
-        commit = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
-                                timeout=10).stdout.strip() or "unknown"
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True, timeout=10).stdout.strip()
-        commit += "+changes" if dirty else ""
-    except (OSError, subprocess.SubprocessError):
-        pass
-    return {"pydem": __version__, "libdem": LIBDEM_VERSION, "git_commit": commit, "host": platform.node(),
-            "machine": f"{platform.machine()}, {os.cpu_count()} cores", "python": platform.python_version(),
-            "command": " ".join(sys.argv), "created": time.strftime("%Y-%m-%d %H:%M:%S %z")}
 
 
 class Progress:
@@ -190,14 +172,17 @@ class Campaign:
         progress.update("error" not in out)
 
     def _run_local(self, workers, args, progress):
-        from .workers import run_local
+        from .workers import WorkerStartError, run_local
         threads = int(self.store.spec.fixed.get("num_threads", 1))
         workers = workers or max(1, (os.cpu_count() or 1) // threads)
 
         def say(msg):
             sys.stderr.write(f"\n  {msg}\n")
 
-        run_local(args, simulate, min(workers, len(args)), lambda i, out: self._finish(i, out, progress), say)
+        try:
+            run_local(args, simulate, min(workers, len(args)), lambda i, out: self._finish(i, out, progress), say)
+        except WorkerStartError as exc:
+            raise StoreError(f"{self.store.path}: {exc}") from None
 
     def _run_dask(self, address, args, progress):
         try:

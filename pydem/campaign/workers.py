@@ -21,6 +21,11 @@ from multiprocessing.connection import wait
 from typing import Callable
 
 RETRIES_AFTER_LOSS = 1  # a worker killed from outside: its run is tried once more
+MAX_BROKEN = 3          # workers in a row that exit with an error code and no result: stop
+
+
+class WorkerStartError(RuntimeError):
+    """Worker processes cannot run at all (they exit with an error before any result)."""
 
 
 def _die_with_parent(parent: int):
@@ -67,6 +72,7 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
     running: dict = {}  # sentinel -> (index, process, connection, start)
     parent = os.getpid()
     interrupted = None
+    broken = 0  # workers in a row that exited with an error and no result: they cannot start
 
     def start(i):
         recv, send = ctx.Pipe(duplex=False)
@@ -100,6 +106,15 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
                     out = None
                 recv.close()
                 p.join()
+                if out is None and p.exitcode and p.exitcode > 0:
+                    broken += 1
+                    if broken >= MAX_BROKEN:  # e.g. the code does not import: stop rather than fail every run
+                        queue.insert(0, i)
+                        raise WorkerStartError(f"{broken} worker processes in a row exited with code {p.exitcode} "
+                                               f"before returning a result (see their error above); the runs stay "
+                                               f"pending")
+                elif out is not None:
+                    broken = 0
                 if out is None:  # killed from outside (OOM killer, kill -9): no result
                     tries[i] += 1
                     how = f"signal {-p.exitcode}" if p.exitcode and p.exitcode < 0 else f"exit code {p.exitcode}"

@@ -29,6 +29,7 @@ class RigResult:
     series: dict[str, np.ndarray] = field(default_factory=dict)
     frames: list[str] = field(default_factory=list)
     info: dict = field(default_factory=dict)  # particle count, steps, wall time, settings
+    provenance: dict = field(default_factory=dict)  # config, parameters, seed, versions (set by the caller)
 
     def summary(self) -> str:
         lines = [f"{self.rig}: {self.info.get('particles', '?')} particles, {self.info.get('steps', '?')} steps, "
@@ -39,7 +40,7 @@ class RigResult:
 
     def to_dict(self) -> dict:
         return {"rig": self.rig, "metrics": {k: dataclasses.asdict(m) for k, m in self.metrics.items()},
-                "info": self.info, "frames": self.frames}
+                "info": self.info, "frames": self.frames, "provenance": self.provenance}
 
     def save(self, path: str | Path):
         """HDF5 (.h5: metrics as attributes, series as datasets) or JSON (anything else)."""
@@ -49,6 +50,7 @@ class RigResult:
             with h5py.File(path, "w") as f:
                 f.attrs["rig"] = self.rig
                 f.attrs["info"] = json.dumps(self.info, default=str)
+                f.attrs["provenance"] = json.dumps(strict_json(self.provenance), default=str)
                 g = f.create_group("metrics")
                 for k, m in self.metrics.items():
                     g.attrs[k] = m.value
@@ -59,7 +61,20 @@ class RigResult:
                     s.create_dataset(k, data=np.asarray(v))
                 f.create_dataset("frames", data=np.array(self.frames, dtype=object), dtype=h5py.string_dtype())
         else:
-            path.write_text(json.dumps(self.to_dict(), indent=1, default=str))
+            path.write_text(json.dumps(strict_json(self.to_dict()), indent=1, default=str, allow_nan=False))
+
+
+def strict_json(obj):
+    """NaN and infinities -> None (JSON has no NaN), numpy scalars -> Python numbers."""
+    if isinstance(obj, (np.floating, np.integer)):
+        obj = obj.item()
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [strict_json(v) for v in obj]
+    return obj
 
 
 def block_average(x, n_blocks: int = 5) -> tuple[float, float]:
