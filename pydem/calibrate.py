@@ -96,6 +96,8 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
               threads: int = 2, seed: int = 0, confirm: bool = True, selection: str = "one-se") -> dict:
     from .mlp import NativeMLP
     from . import report
+    if samples < 1:
+        raise ValueError(f"--samples must be a positive number of combinations, got {samples}")
     t_start = time.perf_counter()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -75,6 +75,9 @@ def main(args) -> int:
     except (SpecError, StoreError) as exc:
         print(f"pydem campaign: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # e.g. an export to a directory that does not exist
+        print(f"pydem campaign: {exc.filename or ''}: {exc.strerror or exc}".replace(": : ", ": "), file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("\npydem campaign: interrupted; finished runs are saved, run again to continue", file=sys.stderr)
         return 130

@@ -189,7 +189,11 @@ class Campaign:
             from distributed import Client, as_completed
         except ImportError:
             raise StoreError("--dask needs the 'distributed' package (pip install distributed)") from None
-        with Client(address, timeout="30s") as client:
+        try:
+            client = Client(address, timeout="30s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise StoreError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
+        with client:
             futures = {client.submit(simulate, *a, pure=False, key=f"pydem-sample-{i}-{a[2]}"): i for i, a in args.items()}
             index = {f.key: i for f, i in futures.items()}
             for fut in as_completed(list(futures)):

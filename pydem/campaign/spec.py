@@ -51,6 +51,8 @@ class CampaignSpec:
             raise SpecError(f"rig: unknown rig {self.rig!r} (known: {', '.join(sorted(RIGS))})")
         if self.design not in ("sobol", "lhs"):
             raise SpecError(f"design: {self.design!r} is not sobol or lhs")
+        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
+            raise SpecError(f"seed: expected a non-negative integer, got {self.seed!r}")
         if not isinstance(self.samples, int) or self.samples < 1:
             raise SpecError(f"samples: expected a positive integer, got {self.samples!r}")
         if not isinstance(self.replicates, int) or self.replicates < 1:
@@ -107,6 +109,6 @@ class CampaignSpec:
             if not (isinstance(v, list) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)):
                 raise SpecError(f"{path}: ranges.{k} must be [low, high], got {v!r}")
         return cls(rig=data["rig"], preset=data.get("preset", "default"), design=data.get("design", "sobol"),
-                   seed=int(data.get("seed", 0)), samples=data.get("samples", 64),
+                   seed=data.get("seed", 0), samples=data.get("samples", 64),
                    replicates=data.get("replicates", 1), fixed=dict(data.get("set", {})),
                    ranges={k: tuple(v) for k, v in ranges.items()}, log_scale=tuple(data.get("log_scale", ())))
