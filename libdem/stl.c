@@ -62,14 +62,16 @@ static void skip_space(cursor *c)
     }
 }
 
-/* Next whitespace-delimited token into tok (truncated to toksz - 1); 0 at end of input. */
+/* Next whitespace-delimited token into tok (truncated to toksz - 1), in lower case: keywords
+ * are case-insensitive ("SOLID", "Facet" are written by some exporters) and numbers read the
+ * same; 0 at end of input. */
 static int next_token(cursor *c, char *tok, size_t toksz)
 {
     skip_space(c);
     if (c->p >= c->end) return 0;
     size_t k = 0;
     while (c->p < c->end && !isspace((unsigned char)*c->p)) {
-        if (k + 1 < toksz) tok[k++] = *c->p;
+        if (k + 1 < toksz) tok[k++] = (char)tolower((unsigned char)*c->p);
         c->p++;
     }
     tok[k] = '\0';
@@ -179,6 +181,18 @@ static int parse_ascii(const unsigned char *buf, size_t len, stl_soup *out, char
     return STL_OK;
 }
 
+/* ASCII STL: after an optional UTF-8 byte-order mark and white space, "solid" in any case, and
+ * no NUL byte anywhere. */
+static int starts_ascii(const unsigned char *buf, size_t len)
+{
+    size_t i = (len >= 3 && buf[0] == 0xEF && buf[1] == 0xBB && buf[2] == 0xBF) ? 3 : 0;
+    while (i < len && isspace(buf[i])) i++;
+    static const char word[] = "solid";
+    for (int k = 0; k < 5; k++)
+        if (i + (size_t)k >= len || tolower(buf[i + (size_t)k]) != word[k]) return 0;
+    return memchr(buf, '\0', len) == NULL;
+}
+
 int dem_stl_parse(const unsigned char *buf, size_t len, stl_soup *out, char *err, size_t errsz)
 {
     out->xyz = NULL;
@@ -189,8 +203,9 @@ int dem_stl_parse(const unsigned char *buf, size_t len, stl_soup *out, char *err
         rc = STL_BAD;
     } else if (len >= 84 && (uint64_t)len == 84 + 50 * (uint64_t)read_u32le(buf + 80)) {
         rc = parse_binary(buf, len, out, err, errsz);
-    } else if (len >= 5 && memcmp(buf, "solid", 5) == 0 && memchr(buf, '\0', len) == NULL) {
-        rc = parse_ascii(buf, len, out, err, errsz);
+    } else if (starts_ascii(buf, len)) {
+        size_t skip = (len >= 3 && buf[0] == 0xEF && buf[1] == 0xBB && buf[2] == 0xBF) ? 3 : 0; /* UTF-8 BOM */
+        rc = parse_ascii(buf + skip, len - skip, out, err, errsz);
     } else if (len >= 84) {
         uint32_t n = read_u32le(buf + 80);
         snprintf(err, errsz,

@@ -19,7 +19,16 @@ COLOR_MODES = {"material": lib.DEM_COLOR_MATERIAL, "scalar": lib.DEM_COLOR_SCALA
 
 
 def _array(values, dtype, shape_tail: tuple, name: str, n: int | None = None) -> np.ndarray:
-    """C-contiguous array of dtype with shape (n, *shape_tail); no copy when already so."""
+    """C-contiguous array of dtype with shape (n, *shape_tail); no copy when already so. An
+    integer dtype refuses values that are not whole numbers (a triangle index 2.5 is an error,
+    never truncated)."""
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        raw = np.asarray(values)
+        if raw.dtype.kind not in "iub":
+            f = raw.astype(np.float64)
+            if not np.all(np.isfinite(f)) or np.any(f != np.round(f)):
+                raise DemInvalidArgument(f"{name} must be whole numbers, got {f[(~np.isfinite(f)) | (f != np.round(f))][:3]}",
+                                         "DEM_ERR_INVALID_ARGUMENT")
     a = np.ascontiguousarray(values, dtype=dtype)
     if shape_tail and a.ndim == 1 and a.size == int(np.prod(shape_tail)) and n in (None, 1):
         a = a.reshape((1, *shape_tail))

@@ -4,6 +4,7 @@
  * never crash the reader (this program also runs under ASan/UBSan in make test). */
 #include "test_util.h"
 #include "stl.h"
+#include <ctype.h>
 #include <dirent.h>
 #include <unistd.h>
 
@@ -83,6 +84,38 @@ static void test_malformed_files(void **state)
     assert_int_equal(m, 0);
     assert_ok(dem_domain_step(d, 3));
     dem_domain_destroy(d);
+}
+
+/* Spreadsheet- and CAD-written ASCII files: a UTF-8 byte-order mark, leading white space and
+ * upper-case keywords read as the plain file does (12 triangles of the seed cube). */
+static void test_ascii_bom_and_upper_case(void **state)
+{
+    (void)state;
+    FILE *f = fopen(CORPUS "/seed_ascii_cube.stl", "rb");
+    assert_non_null(f);
+    static char text[1 << 16];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    static unsigned char buf[(1 << 16) + 8];
+    for (int variant = 0; variant < 3; variant++) {
+        size_t len = 0;
+        if (variant != 1) { /* 0: BOM; 2: BOM + upper case */
+            buf[0] = 0xEF, buf[1] = 0xBB, buf[2] = 0xBF;
+            len = 3;
+        } else {
+            buf[0] = '\n', buf[1] = ' ';
+            len = 2;
+        }
+        for (size_t k = 0; k < n; k++) buf[len++] = (unsigned char)(variant >= 1 ? toupper((unsigned char)text[k]) : text[k]);
+        stl_soup soup;
+        char err[256];
+        if (dem_stl_parse(buf, len, &soup, err, sizeof err) != STL_OK) {
+            print_error("variant %d: %s\n", variant, err);
+            fail();
+        }
+        assert_int_equal(soup.n, 12);
+        free(soup.xyz);
+    }
 }
 
 static void test_degenerate_triangles_skipped(void **state)
@@ -207,6 +240,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ascii_and_binary_cube),
         cmocka_unit_test(test_malformed_files),
+        cmocka_unit_test(test_ascii_bom_and_upper_case),
         cmocka_unit_test(test_degenerate_triangles_skipped),
         cmocka_unit_test(test_mesh_particle_overlap),
         cmocka_unit_test(test_fuzz_corpus),

@@ -141,3 +141,15 @@ def test_snapshot_and_render_round_trip(tmp_path):
     assert img.shape == (32, 64, 3) and (img != 255).any()
     d.render_png(tmp_path / "f.png")
     assert (tmp_path / "f.png").read_bytes()[1:4] == b"PNG"
+
+
+def test_integer_arrays_refuse_fractions():
+    """A triangle index 2.5 is an error naming the array, never silently truncated to 2."""
+    import numpy as np
+    import pytest
+    d = pydem.Domain(hi=(1, 1, 1))
+    m = d.add_material()
+    verts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    with pytest.raises(pydem.DemInvalidArgument, match=r"triangles must be whole numbers, got \[2.5\]"):
+        d.add_mesh_wall((verts, np.array([[0, 1, 2.5]])), material=m)
+    d.add_mesh_wall((verts, np.array([[0, 1, 2.0]])), material=m)  # whole floats are fine
