@@ -68,18 +68,20 @@ typedef struct reader {
     char *msg;
     size_t msg_size;
     dem_domain *d;
+    const char *path; /* named in every message */
 } reader;
 
 static dem_status bad(reader *r, const char *what)
 {
-    if (r->msg && r->msg_size) snprintf(r->msg, r->msg_size, "dem_snapshot_read: %s", what);
+    if (r->msg && r->msg_size) snprintf(r->msg, r->msg_size, "dem_snapshot_read: '%s': %s", r->path, what);
     return DEM_ERR_FORMAT;
 }
 
 /* Turns a failed library call during reading into a message. */
 static dem_status lib_fail(reader *r, dem_status s)
 {
-    if (r->msg && r->msg_size) snprintf(r->msg, r->msg_size, "dem_snapshot_read: %s", dem_domain_last_error(r->d));
+    if (r->msg && r->msg_size)
+        snprintf(r->msg, r->msg_size, "dem_snapshot_read: '%s': %s", r->path, dem_domain_last_error(r->d));
     return s < 0 ? s : DEM_ERR_FORMAT;
 }
 
@@ -516,7 +518,7 @@ dem_status dem_snapshot_read(const char *path, dem_domain **out, char *msg, size
     *out = NULL;
     if (!path) return DEM_ERR_NULL;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    reader r = {-1, msg, msg_size, NULL};
+    reader r = {-1, msg, msg_size, NULL, path};
     FILE *probe = fopen(path, "rb");
     if (!probe) {
         if (msg && msg_size) snprintf(msg, msg_size, "dem_snapshot_read: cannot open '%s'", path);
