@@ -20,6 +20,7 @@ from .campaign import Campaign
 from .campaign.store import check_same_physics, physics_of
 from .measurements import Measurement, load
 from .rigs import RIGS
+from .rigs.result import strict_json
 
 PROPERTIES = {"ring-shear": ("mu_ie_ps", "mu_ie_s_", "bulk_density"), "aor": ("angle_of_repose", "bulk_density")}
 STAGE_ORDER = ("ring-shear", "aor")  # screen on the shear tester, then narrow with the heap (seed 000)
@@ -195,20 +196,9 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
                    comments="", fmt="%.10g")
     _say("[6/6] report")
     path = report.write(out, summary, trained, sc, cnets, res_sur, res_dem, meas, stores)
-    (out / "summary.json").write_text(json.dumps(_finite(summary), indent=1, default=float))
+    (out / "summary.json").write_text(json.dumps(strict_json(summary), indent=1, default=float))
     _say(f"done in {time.perf_counter() - t_start:.0f} s: {path}")
     return summary
-
-
-def _finite(obj):
-    """NaN -> None, so that summary.json is strict JSON."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    return obj
 
 
 def main_cli(args) -> int:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..rigs.result import strict_json
 from .diagnose import ALPHA, Diagnosis
 
 VERDICT_TEXT = {
@@ -20,18 +21,6 @@ VERDICT_TEXT = {
     "indistinguishable": "The base model fails; {effect} and {others} explain it about equally well with these conditions.",
     "unexplained": "The base model fails, and none of the candidate effects explains the misfit.",
 }
-
-
-def _finite(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    if isinstance(obj, (np.floating, np.integer)):
-        return _finite(obj.item())
-    return obj
 
 
 def verdict_line(d: Diagnosis) -> str:
@@ -123,7 +112,7 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     data = d.as_dict()
     data["context"] = context or {}
-    (out / "diagnosis.json").write_text(json.dumps(_finite(data), indent=1))
+    (out / "diagnosis.json").write_text(json.dumps(strict_json(data), indent=1, allow_nan=False))
     plots = plot_residuals(d)
     for name, png in plots.items():
         (out / name).write_bytes(png)
