@@ -35,6 +35,25 @@ def property_metrics(rig: str, store) -> list[str]:
     return [m for m in store.metric_names if any(m == w or (w.endswith("_") and m.startswith(w)) for w in wanted)]
 
 
+def condition_mismatch(m: Measurement, store) -> str:
+    """Why the campaign cannot represent the row's conditions ('' when it can): the campaign's
+    nets take only its parameters, so its fixed test conditions (pre-shear stress, slot width)
+    must be the row's; an unknown condition is taken as the campaign's and said so."""
+    cfg = store.provenance.get("rig_config", {})
+    for cname in ("preshear_stress", "slot_width"):
+        text = m.conditions.get(cname, "unknown")
+        if text.lower() == "unknown" or cname not in cfg:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            return f"condition {cname}={text!r} is not a number"
+        if abs(value - float(cfg[cname])) > 1e-6 * abs(float(cfg[cname])):
+            return (f"measured at {cname}={value:g}, the campaign {store.path.name} ran at {float(cfg[cname]):g} "
+                    f"(use `pydem diagnose` with a campaign that varies it)")
+    return ""
+
+
 def noise_ceiling(store, metric: str) -> tuple[float, str]:
     """The hold-out R^2 a perfect net would get on the design points' means: 1 - their noise
     variance / their variance, and where the noise comes from: the pooled scatter between
@@ -132,6 +151,12 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     stages, skipped = [], []
     for rig in STAGE_ORDER:
         rows = [m for m in meas if m.use == "calibrate" and m.rig == rig]
+        if rig in stores:  # a row measured at another condition than the campaign's is reported, not matched
+            other = [(m, why) for m in rows for why in [condition_mismatch(m, stores[rig])] if why]
+            for m, why in other:
+                _say(f"  left out: {m.label}: {why}")
+            skipped += [m for m, _ in other]
+            rows = [m for m in rows if not condition_mismatch(m, stores[rig])]
         usable = [(m, net_for(m)) for m in rows]
         skipped += [m for m, n in usable if n is None]
         usable = [(m, n) for m, n in usable if n is not None]

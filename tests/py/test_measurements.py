@@ -62,3 +62,16 @@ def test_calibrate_refuses_measurements_that_match_no_campaign(tmp_path):
     assert r.returncode == 2, r.stdout + r.stderr
     assert "no measurement of 'x' matches a quantity of the given campaigns" in r.stderr
     assert "hopper:mass_flow_rate" in r.stderr and "angle_of_repose" in r.stderr
+
+
+def test_calibrate_reports_rows_at_other_conditions(tmp_path):
+    """The seed-000 chain's campaigns run at one pre-shear stress: a row measured at another is
+    reported as left out, never matched to the campaign's condition; `unknown` is the campaign's."""
+    from pydem.calibrate import condition_mismatch
+    from pydem.campaign import Campaign
+    store = Campaign.open(ROOT / "data/campaigns/ring_shear_cell.h5").store
+    rows = load(write(tmp_path, "x,ring_shear,mu_ie_ps,0.5,0.01,,preshear_stress=5000,calibrate,s\n"
+                                "x,ring_shear,mu_ie_s,0.5,0.01,,preshear_stress=2000;shear_fraction=0.5,calibrate,s\n"
+                                "x,ring_shear,bulk_density,1500,20,kg/m^3,preshear_stress=unknown,calibrate,s\n"))
+    assert "measured at preshear_stress=5000, the campaign ring_shear_cell.h5 ran at 2000" in condition_mismatch(rows[0], store)
+    assert condition_mismatch(rows[1], store) == "" and condition_mismatch(rows[2], store) == ""
