@@ -138,6 +138,13 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
     # screening box: where every campaign has data (the nets do not extrapolate)
     ranges = {n: (max(st.spec.ranges[n][0] for st in stores.values()), min(st.spec.ranges[n][1] for st in stores.values()))
               for n in names}
+    matched = [m for m in meas if m.use == "calibrate" and m.rig in stores
+               and m.metric in property_metrics(m.rig, stores[m.rig]) and not condition_mismatch(m, stores[m.rig])]
+    if not matched:  # before any training: nothing to calibrate against
+        offered = ", ".join(f"{rig}: {', '.join(property_metrics(rig, st))}" for rig, st in stores.items())
+        rows = ", ".join(m.label for m in meas if m.use == "calibrate") or "none marked use=calibrate"
+        raise ValueError(f"{measurements}: no measurement of {material!r} matches a quantity of the given campaigns "
+                         f"(measurements: {rows}; campaigns offer {offered})")
     _say(f"[1/6] campaigns: " + ", ".join(f"{rig} {st.counts()['done']} runs ({st.path.name})" for rig, st in stores.items()))
     _say(f"[2/6] training one MLP per property (hidden sizes {min(sizes)}-{max(sizes)}, {restarts} restarts, 15 % hold-out, "
          f"selection {selection})")
@@ -161,11 +168,6 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
         skipped += [m for m, n in usable if n is None]
         usable = [(m, n) for m, n in usable if n is not None]
         stages.append(screening.Stage(rig, [n for _, n in usable], [m for m, _ in usable], window))
-    if not any(st.measurements for st in stages):
-        offered = ", ".join(f"{rig}: {', '.join(property_metrics(rig, st))}" for rig, st in stores.items())
-        rows = ", ".join(m.label for m in meas if m.use == "calibrate") or "none marked use=calibrate"
-        raise ValueError(f"{measurements}: no measurement of {material!r} matches a quantity of the given campaigns "
-                         f"(measurements: {rows}; campaigns offer {offered})")
     _say(f"[3/6] screening {samples:,} combinations (scrambled Sobol) natively, {threads} threads, window ±{100 * window:g} %")
     sc = screening.run(names, ranges, stages, samples, seed=7, threads=threads)
     for st, idx in zip(sc.stages, sc.admissible):
