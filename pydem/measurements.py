@@ -30,11 +30,12 @@ _COEF = ("", {"": 1.0, "-": 1.0, "1": 1.0}, (0.0, 5.0))
 _DENSITY = ("kg/m^3", {"kg/m^3": 1.0, "kg/m3": 1.0, "kg m-3": 1.0, "g/cm^3": 1000.0, "g/cm3": 1000.0,
                        "g/ml": 1000.0, "t/m^3": 1000.0, "t/m3": 1000.0}, (10.0, 2.5e4))
 _STRESS = ("Pa", {"pa": 1.0, "kpa": 1000.0}, (0.0, 1e8))
+_ANGLE = ("deg", {"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees": 1.0, "rad": 57.29577951308232}, (0.0, 90.0))
 QUANTITIES_OF_TEST = {
     "ring_shear": {"mu_ie_ps": _COEF, "mu_ie_s": _COEF, "bulk_density": _DENSITY, "tau_shear": _STRESS,
-                   "tau_preshear": _STRESS},
-    "aor": {"angle_of_repose": ("deg", {"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees": 1.0,
-                                        "rad": 57.29577951308232}, (0.0, 90.0)), "bulk_density": _DENSITY},
+                   "tau_preshear": _STRESS, "phi_e": _ANGLE, "phi_lin": _ANGLE, "phi_sf": _ANGLE, "sigma_1": _STRESS,
+                   "sigma_c": _STRESS, "yield_locus_intercept": _STRESS, "ffc": ("", {"": 1.0, "-": 1.0}, (0.0, 1e6))},
+    "aor": {"angle_of_repose": _ANGLE, "bulk_density": _DENSITY},
     "poured": {"bulk_density": _DENSITY},
     "hopper": {"mass_flow_rate": ("kg/s", {"kg/s": 1.0, "g/s": 1e-3, "t/h": 1.0 / 3.6}, (0.0, 1e6)),
                "discharge_time": ("s", {"s": 1.0, "min": 60.0}, (0.0, 1e7)), "bulk_density": _DENSITY},

@@ -84,9 +84,9 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     names = [c.effect for c in d.candidates][::-1]
     vals = [c.statistic for c in d.candidates][::-1]
     from scipy import stats
-    thr = float(stats.chi2.isf(2 * ALPHA, 1))
     ax.barh(names, vals, color=["C3" if c.p_value < ALPHA else "C0" for c in d.candidates][::-1])
-    ax.axvline(thr, color="k", ls=":", label=f"p = {ALPHA:g} (one-sided)")
+    ax.axvline(float(stats.chi2.isf(2 * ALPHA, 1)), color="k", ls=":", label=f"p = {ALPHA:g}, one-sided (cohesion)")
+    ax.axvline(float(stats.chi2.isf(ALPHA, 1)), color="k", ls="--", label=f"p = {ALPHA:g}, two-sided")
     ax.set_xlabel("profile-likelihood ratio (chi^2 base - chi^2 with the effect)")
     ax.legend(fontsize=7)
     if not names:

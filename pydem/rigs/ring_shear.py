@@ -27,6 +27,7 @@ import numpy as np
 from .. import geometry
 from .common import Stepper, frame, lattice_fill, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
+from . import yield_locus as locus
 from .result import Metric, RigResult, block_average
 
 
@@ -241,6 +242,19 @@ class RingShear:
             slope, icpt = yield_locus([q[1] for q in points], [q[2] for q in points])
             res.metrics["yield_locus_slope"] = Metric(*slope, "", "least squares through the shear points")
             res.metrics["yield_locus_intercept"] = Metric(*icpt, "Pa", "cohesion estimate")
+            try:  # the outputs a Schulze tester reports (yield_locus.py)
+                loc = locus.evaluate(sigma_pre, tau_pre, [q[1] for q in points], [q[2] for q in points])
+            except ValueError as exc:
+                res.info["yield_locus_note"] = str(exc)
+            else:
+                for key, value, unit, note in (
+                        ("phi_lin", loc.phi_lin, "deg", "linearised angle of internal friction"),
+                        ("phi_e", loc.phi_e, "deg", "effective angle of internal friction"),
+                        ("phi_sf", loc.phi_sf, "deg", "steady-state flow angle"),
+                        ("sigma_1", loc.sigma_1, "Pa", "major consolidation stress"),
+                        ("sigma_c", loc.sigma_c, "Pa", "unconfined yield strength"),
+                        ("ffc", loc.ffc, "", "flow function sigma_1 / sigma_c")):
+                    res.metrics[key] = Metric(value, math.nan, unit, note)
         res.metrics["bulk_density"] = Metric(mass / (area * z_lid), math.nan, "kg/m^3", "mass / (lid area x lid height)")
         gamma_dot = c.shear_speed / z_lid
         res.metrics["inertial_number"] = Metric(gamma_dot * dm / math.sqrt(sigma_pre / p.density), math.nan, "",

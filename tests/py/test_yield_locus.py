@@ -1,0 +1,45 @@
+"""Schulze yield-locus outputs against a hand-worked locus: tau = 500 Pa + sigma tan 30 deg,
+pre-shear at sigma_pre = 2000 Pa on the circle that touches the locus.
+
+By hand: sin 30 = 1/2, cos 30 = sqrt(3)/2, c cos(phi) = 250 sqrt(3) = 433.013 Pa.
+sigma_c = 2 c cos(phi) / (1 - sin(phi)) = 2 * 433.013 / 0.5 = 1732.05 Pa.
+Take the consolidation circle with centre p = 3000 Pa: radius r = 433.013 + 1500 = 1933.013 Pa;
+the pre-shear point on it at sigma_pre = 2000 Pa has tau_pre = sqrt(r^2 - 1000^2) = 1654.26 Pa.
+sigma_1 = p + r = 4933.01 Pa; ffc = 4933.01 / 1732.05 = 2.84809;
+phi_e = asin(r / p) = asin(0.644338) = 40.116 deg; phi_sf = atan(1654.26 / 2000) = 39.595 deg."""
+import math
+
+import pytest
+
+from pydem.rigs.yield_locus import evaluate
+
+
+def test_hand_worked_locus():
+    c, phi = 500.0, math.radians(30.0)
+    sigma = [800.0, 1200.0, 1600.0]
+    tau = [c + s * math.tan(phi) for s in sigma]
+    r = 250 * math.sqrt(3) + 1500.0
+    tau_pre = math.sqrt(r * r - 1000.0 ** 2)
+    res = evaluate(2000.0, tau_pre, sigma, tau)
+    assert res.phi_lin == pytest.approx(30.0, abs=1e-9)
+    assert res.cohesion == pytest.approx(500.0, rel=1e-9)
+    assert res.sigma_c == pytest.approx(1732.0508, rel=1e-6)
+    assert res.centre == pytest.approx(3000.0, rel=1e-9) and res.radius == pytest.approx(1933.0127, rel=1e-6)
+    assert res.sigma_1 == pytest.approx(4933.0127, rel=1e-6)
+    assert res.ffc == pytest.approx(2.848076, rel=1e-5)
+    assert res.phi_e == pytest.approx(math.degrees(math.asin(r / 3000.0)), rel=1e-9)
+    assert res.phi_e == pytest.approx(40.116, abs=1e-3)
+    assert res.phi_sf == pytest.approx(39.595, abs=1e-3)
+
+
+def test_cohesionless_locus_and_bad_input():
+    """No cohesion: sigma_c = 0, ffc unbounded, phi_e = phi_lin (the circle touches a line through
+    the origin); one normal stress or a pre-shear point above the locus is refused."""
+    res = evaluate(2000.0, 2000.0 * math.tan(math.radians(25)) * 0.9, [500.0, 1000.0, 1500.0],
+                   [s * math.tan(math.radians(25)) for s in (500.0, 1000.0, 1500.0)])
+    assert res.sigma_c == pytest.approx(0.0, abs=1e-6) and res.ffc > 1e6  # intercept 0 up to round-off
+    assert res.phi_e == pytest.approx(25.0, abs=1e-9)
+    with pytest.raises(ValueError, match="two or more normal stresses"):
+        evaluate(2000.0, 900.0, [1000.0, 1000.0], [500.0, 510.0])
+    with pytest.raises(ValueError, match="above the yield locus"):
+        evaluate(2000.0, 5000.0, [500.0, 1000.0], [250.0, 500.0])
