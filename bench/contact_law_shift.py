@@ -37,9 +37,9 @@ def run(root: Path, label: str):
     have = done()
     jobs = [(f"{rig} tiny", rig, "tiny", {}, s) for rig in TINY for s in SEEDS]
     store = Campaign.open(HERE / "data/campaigns/aor_default.h5").store
-    for p in DEFAULT_POINTS:
+    for p in DEFAULT_POINTS:  # three seeds per point: one run differs from another by chaos alone
         values = dict(zip(store.spec.names, map(float, store.params[p])))
-        jobs.append((f"aor default point {p}", "aor", "default", values, int(store.seeds[p])))
+        jobs += [(f"aor default point {p}", "aor", "default", values, int(store.seeds[p]) + k) for k in range(3)]
     for case, rig, preset, params, seed in jobs:
         if (label, case, seed) in have:
             continue
