@@ -207,7 +207,10 @@ def calibrate(measurements: str | Path, material: str, campaigns: list[str | Pat
         _say("[5/6] confirming DEM runs skipped (--no-confirm)")
     res_sur = cmp.compare(meas, surrogate)
     res_dem = cmp.compare(meas, cmp.dem_model(dem_files)) if dem_files else None
-    summary = {"material": material, "measurements": str(measurements), "campaigns": {r: str(s.path) for r, s in stores.items()},
+    from .provenance import provenance
+    summary = {"provenance": provenance() | {"campaign_provenance": {r: s.provenance.get("git_commit") for r, s in stores.items()},
+                                              "seed": seed, "samples": samples, "window": window},
+               "material": material, "measurements": str(measurements), "campaigns": {r: str(s.path) for r, s in stores.items()},
                "names": names, "ranges": ranges, "window": window, "samples": len(sc.points), "best": best,
                "stages": [{"name": st.name, "measured": [m.label for m in st.measurements], "rows": st.rows,
                            "admissible": int(len(idx)), "seconds": st.seconds, "ranges": sc.ranges_of(idx)}

@@ -39,7 +39,7 @@ class ProgressLine:
         self.stream.write("\n")
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="pydem", description="libdem/pydem: DEM lab-test rigs for calibrating bulk solids")
     sub = ap.add_subparsers(dest="command", required=True)
     rig = sub.add_parser("rig", help="run a lab-test rig")
@@ -57,7 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     cli_compare.add_parser(sub)
     cli_diagnose.add_parser(sub)
     calibrate.add_parser(sub)
-    args = ap.parse_args(argv)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
     if hasattr(args, "func"):
         return args.func(args)
 

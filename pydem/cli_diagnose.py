@@ -48,8 +48,10 @@ def main(args) -> int:
         print(f"pydem diagnose: {exc}", file=sys.stderr)
         return 2
     d.notes += [f"left out: {line}" for line in skipped]
-    context = {"measurements": str(args.measurements), "stores": {r: str(s.path) for r, s in setup.stores.items()},
-               "libdem_of_stores": setup.physics}
+    from .provenance import provenance
+    context = {"provenance": provenance(), "measurements": str(args.measurements),
+               "stores": {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem")}
+                          for r, s in setup.stores.items()}, "libdem_of_stores": setup.physics}
     if args.confirm:
         from .calibration.synthetic import rig_values
         fit, model = (d.after, d.after_model) if d.after is not None else (d.base, d.base_model)
