@@ -82,3 +82,12 @@ def test_documented_campaign_toml(doc, tmp_path):
         f = tmp_path / f"block{k}.toml"
         f.write_text(block)
         CampaignSpec.from_toml(f)  # every key resolves and both range ends are allowed
+
+
+def test_readme_python_blocks_run(tmp_path):
+    """The README's Python examples run as written (in a fresh directory)."""
+    for k, block in enumerate(blocks(ROOT / "README.md", "python")):
+        f = tmp_path / f"example{k}.py"
+        f.write_text(block)
+        r = subprocess.run([sys.executable, str(f)], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr[-2000:]
