@@ -61,7 +61,8 @@ def main(args) -> int:
         inputs.update(fit.as_dict())
         say(f"confirming DEM runs at the final estimate ({len({(o.quantity.rig, str(o.conditions)) for o in obs})} "
             f"condition groups at most)")
-        values = rig_values(setup.stores, inputs, obs, seed=12345, threads=args.threads, say=say)
+        from .cli import ProgressLine
+        values = rig_values(setup.stores, inputs, obs, seed=12345, threads=args.threads, say=say, progress=ProgressLine())
         context["confirm"] = [{"label": obs[i].label, "measured": obs[i].value, "dem": v,
                                "relative": (obs[i].value - v) / obs[i].value} for i, v in sorted(values.items())]
         for row in context["confirm"]:

@@ -119,7 +119,7 @@ def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np
 
 
 def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], seed: int, threads: int = 1,
-               say=print) -> dict[int, float]:
+               say=print, progress=None) -> dict[int, float]:
     """One rig run per condition group of `obs` at the stores' presets with the given parameter
     values (a ring-shear run measures its pre-shear and every shear point): {observation index:
     value}. An observation whose run failed is missing from the result."""
@@ -141,10 +141,12 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
         cfg.num_threads = threads
         t0 = time.perf_counter()
         try:
-            res = RIGS[rig][0](cfg).run(seed=seed)
+            res = RIGS[rig][0](cfg).run(seed=seed, progress=progress)
         except Exception as exc:  # a run that fails is reported, the others go on
             say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)} failed: {exc}")
             continue
+        if progress is not None:
+            progress.done()
         say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)}: {time.perf_counter() - t0:.0f} s")
         for i in idx:
             o = obs[i]
