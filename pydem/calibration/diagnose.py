@@ -108,6 +108,7 @@ class Diagnosis:
                 "after": self.summary_of(self.after, self.after_model),
                 "parameters": params, "base_parameters": {n: v for n, v in self.base.posterior.get("parameters", {}).items()},
                 "correlation": {"names": final.posterior.get("names"), "matrix": final.posterior.get("correlation")},
+                "admissible_window": final.posterior.get("admissible_window"),
                 "similarity": self.similarity, "separating_condition": self.separating,
                 "groups": self.groups, "residuals_before": self.residual_table(False),
                 "residuals_after": self.residual_table(True) if self.after is not None else None,

@@ -148,6 +148,13 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
             for k, v in params.items()]
     md, h = _table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
+    win = data.get("admissible_window") or {}
+    if win:
+        line = (f"Seed 000's view: {win['admissible']:,} of {win['samples']:,} uniform samples of the box predict every "
+                f"measured value within ±{100 * win['window']:g} %" + (": " + ", ".join(
+                    f"{k} {v[0]:.3g}–{v[1]:.3g}" for k, v in win["ranges"].items()) if win["ranges"] else "") + ".")
+        md += "\n\n" + line
+        h += f"<p>{html.escape(line)}</p>"
     sections.append(("Parameters" + (f" (with {d.effect})" if d.after is not None else ""), md, h))
     for title, key in (("Residuals, base model", "residuals_before"), ("Residuals, with the effect", "residuals_after")):
         if not data.get(key):
