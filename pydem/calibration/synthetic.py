@@ -29,6 +29,11 @@ NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("
 def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6, 0.8), slots=None) -> list[Observation]:
     """The conditions grid, for the quantities the nets offer (values to be filled in)."""
     out = []
+    hopper = [n for q, n in nets.items() if q.rig == "hopper"]
+    if hopper and slots is None:  # one grid for every hopper quantity: three runs, not one per quantity
+        lo = max(n.lo[n.input_names.index("slot_width")] for n in hopper)
+        hi = min(n.hi[n.input_names.index("slot_width")] for n in hopper)
+        slots = tuple(float(f"{b:.3g}") for b in np.linspace(lo, hi, 5)[1:4])
     for q in sorted(nets, key=lambda q: q.key):
         net = nets[q]
         if q.rig == "ring-shear":
@@ -40,9 +45,7 @@ def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6
                     out.append(Observation(q, {"preshear_stress": s}, math.nan, math.nan,
                                            f"ring_shear:{q.metric} (preshear_stress={s:g})"))
         elif q.rig == "hopper":
-            j = net.input_names.index("slot_width")
-            widths = slots or tuple(np.linspace(net.lo[j], net.hi[j], 5)[1:4])
-            for b in widths:
+            for b in slots:
                 out.append(Observation(q, {"slot_width": float(b)}, math.nan, math.nan,
                                        f"hopper:{q.metric} (slot_width={b:.4g})"))
         else:
