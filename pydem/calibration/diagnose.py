@@ -90,7 +90,7 @@ class Diagnosis:
         rows = []
         for o, f, s, net in zip(self.observations, pred, model.sigma, model.nets):
             rows.append({"quantity": o.quantity.key, "conditions": o.conditions, "label": o.label,
-                         "measured": o.value, "u_measured": o.uncertainty, "model": float(f), "u_model": net.net_error, "scatter": net.scatter, "sigma": float(s),
+                         "measured": o.value, "u_measured": o.uncertainty, "model": float(f), "u_model": net.net_error, "scatter": net.seed_sd, "sigma": float(s),
                          "z": float((o.value - f) / s), "relative": float((o.value - f) / o.value)})
         return rows
 

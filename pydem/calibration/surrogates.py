@@ -46,19 +46,22 @@ class QuantityNet:
     scatter: float = float("nan")  # seed-to-seed sd of one run, from replicate runs (nan: unknown)
 
     @property
+    def seed_sd(self) -> float:
+        """One run's seed-to-seed scatter: measured from replicates, else the whole hold-out RMSE
+        (a store without replicates cannot split its error; all of it counts as scatter)."""
+        return self.scatter if np.isfinite(self.scatter) else self.rmse
+
+    @property
     def net_error(self) -> float:
-        """The net's own error: its hold-out RMSE less the seed scatter it contains (at least a
-        fifth of the RMSE); the whole RMSE when the scatter is unknown."""
-        if not np.isfinite(self.scatter):
-            return self.rmse
-        return float(np.sqrt(max(self.rmse ** 2 - self.scatter ** 2, (0.2 * self.rmse) ** 2)))
+        """The net's own error: its hold-out RMSE less the seed scatter it contains, at least a fifth
+        of the RMSE (also when the scatter is unknown)."""
+        return float(np.sqrt(max(self.rmse ** 2 - self.seed_sd ** 2, (0.2 * self.rmse) ** 2)))
 
     def row_sigma(self, u: float) -> float:
         """Standard deviation of measured - surrogate for a row with stated uncertainty u: a measured
         value scatters at least as much as one rig run does (a lab's repeat scatter is not smaller
-        than the model specimen's), so max(u, scatter), plus the net's error."""
-        s = self.scatter if np.isfinite(self.scatter) else 0.0
-        return float(np.sqrt(max(u, s) ** 2 + self.net_error ** 2))
+        than the model specimen's), so max(u, seed scatter), plus the net's error."""
+        return float(np.sqrt(max(u, self.seed_sd) ** 2 + self.net_error ** 2))
 
     def _hidden(self, x: np.ndarray):
         s = (x - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0

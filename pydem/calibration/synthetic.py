@@ -101,8 +101,7 @@ def _fill(obs: list[Observation], values: dict, nets: dict, rng: np.random.Gener
     for i, o in enumerate(obs):
         v = values[i]
         n = noise_sd(o.quantity.metric, v)
-        s = nets[o.quantity].scatter
-        s = s if np.isfinite(s) else 0.0
+        s = nets[o.quantity].seed_sd
         out.append(Observation(o.quantity, dict(o.conditions), float(v + rng.normal(0.0, n)), float(math.hypot(n, s)),
                                o.label))
     return out
@@ -116,8 +115,7 @@ def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np
     for i, o in enumerate(obs):
         net = nets[o.quantity]
         x = np.array([[o.conditions.get(n, inp.get(n, math.nan)) for n in net.input_names]])
-        s = net.scatter if np.isfinite(net.scatter) else 0.0
-        values[i] = float(net(x)[0]) + rng.normal(0.0, s)
+        values[i] = float(net(x)[0]) + rng.normal(0.0, net.seed_sd)
     return _fill(obs, values, nets, rng)
 
 
