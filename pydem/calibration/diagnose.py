@@ -74,6 +74,7 @@ class Diagnosis:
     groups: list[dict]           # per-condition-group base recalibration
     loco: dict                   # leave-one-condition-out relative RMSE, before/after
     notes: list[str] = field(default_factory=list)
+    testable: bool = True        # more measurements than base parameters: candidates could be tested
 
     def summary_of(self, fit: Fit | None, model: Model | None) -> dict | None:
         if fit is None:
@@ -102,7 +103,7 @@ class Diagnosis:
             p = post.get(name, {})
             params[name] = {"estimate": float(final.as_dict()[name]), "lo": p.get("lo"), "hi": p.get("hi"),
                             "mean": p.get("mean"), "sd": p.get("sd"), "at_edge": p.get("at_edge")}
-        return {"material": self.material, "verdict": self.verdict, "effect": self.effect,
+        return {"material": self.material, "verdict": self.verdict, "effect": self.effect, "testable": self.testable,
                 "candidates": [c.as_dict() for c in self.candidates], "not_covered": self.not_covered,
                 "before": self.summary_of(self.base, self.base_model),
                 "after": self.summary_of(self.after, self.after_model),
@@ -291,4 +292,4 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
             notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
-                     after, after_model, similarity, separating, groups, loco, notes)
+                     after, after_model, similarity, separating, groups, loco, notes, testable)

@@ -156,13 +156,16 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     uni = qmc.scale(qmc.Sobol(k, scramble=True, seed=seed).random(half), lo, hi)
     gau = rng.multivariate_normal(fit.best, cov, size=samples - half, method="cholesky")
     gau = gau[np.all((gau >= lo) & (gau <= hi), axis=1)]
+    if len(gau) == 0:  # the Gaussian lies outside the box: the uniform samples alone
+        half = len(uni)
     x = np.vstack([uni, gau])
     log_like = -0.5 * model.chi2(x)
     inv = np.linalg.inv(cov)
     d = x - fit.best
     log_g = -0.5 * np.einsum("ij,jk,ik->i", d, inv, d) - 0.5 * np.linalg.slogdet(2 * np.pi * cov)[1]
     log_u = -np.sum(np.log(width))
-    log_q = np.logaddexp(np.log(half / len(x)) + log_u, np.log((len(x) - half) / len(x)) + log_g)
+    frac_g = (len(x) - half) / len(x)
+    log_q = log_u if frac_g == 0 else np.logaddexp(np.log(half / len(x)) + log_u, np.log(frac_g) + log_g)
     lw = log_like + log_u - log_q
     w = np.exp(lw - lw.max())
     w /= w.sum()

@@ -25,7 +25,14 @@ VERDICT_TEXT = {
 
 def verdict_line(d: Diagnosis) -> str:
     sig = [c.effect for c in d.candidates if c.p_value < ALPHA and c.effect != d.effect]
-    return VERDICT_TEXT[d.verdict].format(effect=d.effect, others=", ".join(sig) or "another candidate")
+    line = VERDICT_TEXT[d.verdict].format(effect=d.effect, others=", ".join(sig) or "another candidate")
+    if not d.testable:
+        line += (f" But with {len(d.observations)} measurement(s) for {len(d.base.names)} base parameters no candidate "
+                 f"effect could be tested: measure more conditions.")
+    edges = [n for n, p in d.base.posterior.get("parameters", {}).items() if p.get("at_edge")]
+    if edges:
+        line += f" The base estimate sits at the edge of the campaign range for {', '.join(edges)}."
+    return line
 
 
 def _png(fig) -> bytes:
