@@ -102,8 +102,9 @@ def _fill(obs: list[Observation], values: dict, nets: dict, rng: np.random.Gener
         v = values[i]
         n = noise_sd(o.quantity.metric, v)
         s = nets[o.quantity].seed_sd
-        out.append(Observation(o.quantity, dict(o.conditions), float(v + rng.normal(0.0, n)), float(math.hypot(n, s)),
-                               o.label))
+        # every quantity here is positive: a noise draw below zero (a nearly jammed hopper) is clipped
+        value = max(float(v + rng.normal(0.0, n)), 1e-3 * abs(float(v)), 1e-9)
+        out.append(Observation(o.quantity, dict(o.conditions), value, float(math.hypot(n, s)), o.label))
     return out
 
 
@@ -154,8 +155,9 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
             metric = o.quantity.metric
             if metric == "mu_ie_s":
                 metric = f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
-            if metric in res.metrics and isinstance(res.metrics[metric].value, float):
-                values[i] = float(res.metrics[metric].value)
+            v = res.metrics[metric].value if metric in res.metrics else None
+            if isinstance(v, float) and math.isfinite(v):  # a jammed hopper has no discharge time
+                values[i] = v
     return values
 
 
