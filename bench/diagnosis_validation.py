@@ -37,7 +37,8 @@ def main() -> int:
     setup = load_setup([s for s in stores if s.exists()])
     kinds = {"null": args.null, **{c.name: args.sets for c in setup.candidates}, "unexplained": args.unexplained}
     t0 = time.perf_counter()
-    rows = synthetic.validate(setup, kinds, seed=args.seed, source=args.source, threads=args.threads)
+    journal = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.jsonl"  # resumable
+    rows = synthetic.validate(setup, kinds, seed=args.seed, source=args.source, threads=args.threads, journal=journal)
     scores = synthetic.score_sets(rows)
     out = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.json"
     out.parent.mkdir(exist_ok=True)

@@ -217,15 +217,26 @@ def score_sets(results: list[dict]) -> dict:
 
 
 def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surrogate", threads: int = 1,
-             say=print) -> list[dict]:
+             say=print, journal=None) -> list[dict]:
     """Runs the protocol: kinds = {"null": n, <candidate name>: n, "unexplained": n}; source
     "surrogate" or "dem". One row per set: truth, verdict, chosen effect, errors before/after."""
+    import json
+    from pathlib import Path
     from .diagnose import diagnose
-    rng = np.random.default_rng(seed)
     base_obs = programme(setup.nets)
     rows = []
+    done = {}
+    if journal is not None and Path(journal).exists():  # resumable: finished sets are kept, not redone
+        for line in Path(journal).read_text().splitlines():
+            r = json.loads(line)
+            done[(r["kind"], r["set"])] = r
     for kind, n in kinds.items():
         for k in range(n):
+            # each set its own seeded generator, so a resumed run draws the same sets
+            rng = np.random.default_rng([seed, sum(map(ord, kind)), k])
+            if (kind, k) in done:
+                rows.append(done[(kind, k)])
+                continue
             effect = None if kind in ("null", "unexplained") else kind
             truth = draw_truth(rng, setup.ranges, setup.candidates, effect)
             if source == "dem":
@@ -246,6 +257,9 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                    "rmse_after": s_after["rmse_relative"] if s_after else None,
                    "loco_before": d.loco.get("before"), "loco_after": d.loco.get("after")}
             rows.append(row)
+            if journal is not None:
+                with open(journal, "a") as fh:
+                    fh.write(json.dumps(row, default=float) + "\n")
             say(f"  {source} {kind:14s} #{k}: {d.verdict:18s} {d.effect or '-':14s} chi2/dof {row['chi2_before']:.2f}"
                 + (f" -> {row['chi2_after']:.2f}" if row["chi2_after"] is not None else ""))
     return rows
