@@ -17,8 +17,9 @@ from .diagnose import ALPHA, Diagnosis
 
 VERDICT_TEXT = {
     "no_effect_needed": "The base model is consistent with the measurements: no candidate effect is needed.",
-    "effect": "The base model fails; one missing effect explains it: {effect}.",
-    "indistinguishable": "The base model fails; {effect} and {others} explain it about equally well with these conditions.",
+    "effect": "One missing effect explains the measurements significantly better than the base model: {effect}.",
+    "indistinguishable": "Missing effects explain the measurements significantly better than the base model, but "
+                         "{effect} and {others} about equally well with these conditions.",
     "unexplained": "The base model fails, and none of the candidate effects explains the misfit.",
 }
 

@@ -150,13 +150,17 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
         if progress is not None:
             progress.done()
         say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)}: {time.perf_counter() - t0:.0f} s")
+        dt = res.metrics.get("discharge_time")
+        jammed = rig == "hopper" and not (dt is not None and math.isfinite(dt.value))
         for i in idx:
             o = obs[i]
             metric = o.quantity.metric
+            if jammed and metric in ("mass_flow_rate", "discharge_time"):
+                continue  # a hopper that jammed measured neither a flow rate nor a discharge time
             if metric == "mu_ie_s":
                 metric = f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
             v = res.metrics[metric].value if metric in res.metrics else None
-            if isinstance(v, float) and math.isfinite(v):  # a jammed hopper has no discharge time
+            if isinstance(v, float) and math.isfinite(v) and v > 0:
                 values[i] = v
     return values
 
