@@ -53,13 +53,14 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     before = d.base_model.predict(d.base.best)
     after = d.after_model.predict(d.after.best) if d.after is not None else None
     quantities = sorted({o.quantity for o in d.observations}, key=lambda q: q.key)
     n = len(quantities)
     cols = min(3, n)
     rows = int(math.ceil(n / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.5 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows), squeeze=False, layout="constrained")
     for ax, q in zip(axes.flat, quantities):
         idx = [i for i, o in enumerate(d.observations) if o.quantity == q]
         cname = _axis_condition(q)
@@ -76,12 +77,17 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
             col = f"C{k}"
             ax.errorbar(x, [d.observations[i].value for i in ii], yerr=[d.base_model.sigma[i] for i in ii], fmt="o",
                         color=col, capsize=3, label=f"measured {label}".strip())
-            ax.plot(x, before[ii], "--", color=col, alpha=0.8, label=f"base model {label}".strip())
+            ax.plot(x, before[ii], "--x", color=col, alpha=0.8, label=f"base model {label}".strip())
             if after is not None:
-                ax.plot(x, after[ii], "-", color=col, label=f"with {d.effect or 'best candidate'} {label}".strip())
+                ax.plot(x, after[ii], "-+", color=col, ms=10, label=f"with {d.effect or 'best candidate'} {label}".strip())
         ax.set_title(q.key, fontsize=10)
         if cname == "preshear_stress":
             ax.set_xscale("log")
+            ax.set_xticks(sorted({d.observations[i].conditions[cname] for i in idx}))
+            ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+        elif cname is None:
+            ax.set_xticks([])
         ax.set_xlabel({"preshear_stress": "pre-shear stress (Pa)", "slot_width": "slot width (m)"}.get(cname, ""))
         ax.legend(fontsize=6)
     for ax in list(axes.flat)[n:]:
