@@ -164,7 +164,9 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     d = x - fit.best
     log_g = -0.5 * np.einsum("ij,jk,ik->i", d, inv, d) - 0.5 * np.linalg.slogdet(2 * np.pi * cov)[1]
     log_u = -np.sum(np.log(width))
-    frac_g = (len(x) - half) / len(x)
+    # the kept Gaussian samples have density g / Z (Z: the fraction of the Gaussian inside the box), and
+    # there are about (samples - half) Z of them: their share of the mixture density is (samples - half) g / N
+    frac_g = 0.0 if len(gau) == 0 else (samples - half) / len(x)
     log_q = log_u if frac_g == 0 else np.logaddexp(np.log(half / len(x)) + log_u, np.log(frac_g) + log_g)
     lw = log_like + log_u - log_q
     w = np.exp(lw - lw.max())
