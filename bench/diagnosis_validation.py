@@ -32,8 +32,12 @@ def main() -> int:
     ap.add_argument("--unexplained", type=int, default=20, help="sets with a non-candidate discrepancy")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--stores", nargs="+", help="store paths instead of diag_<rig>_<preset>.h5 (a mix of presets)")
+    ap.add_argument("--label", help="results name (default: the preset)")
     args = ap.parse_args()
-    stores = [ROOT / f"data/campaigns/diag_{r}_{args.preset}.h5" for r in ("ring_shear", "aor", "hopper")]
+    stores = ([ROOT / s for s in args.stores] if args.stores else
+              [ROOT / f"data/campaigns/diag_{r}_{args.preset}.h5" for r in ("ring_shear", "aor", "hopper")])
+    args.preset = args.label or args.preset
     setup = load_setup([s for s in stores if s.exists()])
     kinds = {"null": args.null, **{c.name: args.sets for c in setup.candidates}, "unexplained": args.unexplained}
     t0 = time.perf_counter()
