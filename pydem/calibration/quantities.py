@@ -93,11 +93,6 @@ def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.nda
     names = list(store.spec.names)
     done = store.status == 1
     out = {}
-    fixed = {}
-    cfg = store.spec.config({k: 0.5 * (lo + hi) for k, (lo, hi) in store.spec.ranges.items()})
-    for cname in CONDITIONS[rig]:  # a condition the store does not vary is constant: not an input
-        if cname not in names and hasattr(cfg, cname) and cname != "shear_fraction":
-            fixed[cname] = float(getattr(cfg, cname))
     for metric in QUANTITIES[rig]:
         q = Quantity(rig, metric)
         if metric == "mu_ie_s":
