@@ -1,11 +1,12 @@
 # libdem / pydem — one entry point.
-#   make            static + shared library (strict warnings, warnings are errors)
+#   make            static + shared library (strict warnings, warnings are errors); no Python needed
+#   make pydem      the Python binding in place (pydem/_libdem*.so; the set-up makes .venv)
 #   make test       set-up (idempotent), build, every C test (plain, then under ASan/UBSan),
 #                   then the Python tests
 #   make bench      benchmarks (results in bench/results/)
 #   make demo       the main job (calibration of glass microbeads, report in build/calibration;
 #                   the diagnosis loop, reports in build/diagnosis)
-#   make install PREFIX=/usr/local
+#   make install PREFIX=/usr/local   libdem for any x86-64 (headers, libdem.a, libdem.so.MAJOR, dem.pc)
 CC      ?= gcc
 PREFIX  ?= /usr/local
 BUILD   := build
@@ -34,8 +35,11 @@ BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
 .PHONY: all lib pydem setup test test-c test-sanitize test-py bench bench-screening demo install clean FORCE
 
-all: lib pydem
+all: lib
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
+
+VERSION := $(shell sed -n 's/\#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)
+SONAME  := libdem.so.$(firstword $(subst ., ,$(VERSION)))
 
 $(BUILD)/obj/%.o: libdem/%.c $(HEADERS)
 	@mkdir -p $(dir $@)
@@ -47,14 +51,15 @@ $(BUILD)/libdem.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
+# versioned soname, no rpath: an installed libdem.so.0 is found by the loader's own rules
 $(BUILD)/libdem.so: $(LIB_OBJ)
-	$(CC) -shared -fopenmp -o $@ $^ $(LDLIBS)
+	$(CC) -shared -fopenmp -Wl,-soname,$(SONAME) -o $@ $^ $(LDLIBS)
 
 # pkg-config file for PREFIX (rewritten whenever PREFIX differs from the last one)
 $(BUILD)/dem.pc: FORCE
 	@mkdir -p $(BUILD)
 	@printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: dem\nDescription: libdem discrete element method library\nVersion: %s\nLibs: -L$${libdir} -ldem -fopenmp -lm\nRequires.private: hdf5-serial libpng\nCflags: -I$${includedir}\n' \
-	  "$(PREFIX)" "$$(sed -n 's/#define DEM_VERSION_STRING "\(.*\)"/\1/p' include/dem/base.h)" > $@.tmp
+	  "$(PREFIX)" "$(VERSION)" > $@.tmp
 	@cmp -s $@.tmp $@ || mv $@.tmp $@; rm -f $@.tmp
 
 setup:
@@ -90,6 +95,7 @@ PYDEM_STAMP := $(BUILD)/pydem.stamp
 pydem: $(PYDEM_STAMP)
 $(PYDEM_STAMP): $(BUILD)/libdem.a $(wildcard include/dem/*.h) pydem/_build_ffi.py
 	$(PYTHON) pydem/_build_ffi.py
+	@rm -f pydem/_libdem.abi3.so  # the source-built copy of `pip install -e .`: one binding, make's
 	@touch $@
 
 test-py: pydem
@@ -123,11 +129,17 @@ bench-screening: setup lib
 	@[ -d $(BUILD)/calibration/nets ] || $(MAKE) --no-print-directory demo
 	$(PYTHON) bench/screening.py
 
-install: lib pydem
+# installed from a portable build (no -march: the library may run on another machine than this)
+PORTABLE := $(BUILD)/portable
+install:
+	@$(MAKE) --no-print-directory BUILD=$(PORTABLE) ARCH_OPT= ARCH_OPT_WIDE= PREFIX=$(PREFIX) lib
 	install -d $(DESTDIR)$(PREFIX)/include/dem $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 include/dem/*.h $(DESTDIR)$(PREFIX)/include/dem/
-	install -m 644 $(BUILD)/libdem.a $(BUILD)/libdem.so $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 $(BUILD)/dem.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/dem.pc
+	install -m 644 $(PORTABLE)/libdem.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(PORTABLE)/libdem.so $(DESTDIR)$(PREFIX)/lib/libdem.so.$(VERSION)
+	ln -sf libdem.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libdem.so
+	install -m 644 $(PORTABLE)/dem.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/dem.pc
 
 clean:
 	rm -rf $(BUILD)

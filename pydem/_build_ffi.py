@@ -1,11 +1,13 @@
-"""Builds pydem._libdem: cffi in out-of-line API mode over the public headers and the static
-libdem (build/libdem.a), so the package carries the engine inside and needs no library path.
+"""Builds pydem._libdem: cffi in out-of-line API mode over the public headers, with libdem
+inside the extension, so the package needs no library path. Two routes, one cdef:
+
+- `pip install .` (pyproject.toml, setup.py: cffi_modules) uses `ffibuilder`: libdem compiled
+  from libdem/*.c with portable flags (no -march: a wheel runs on any x86-64);
+- `make pydem` (and so `make test`, `make demo`) runs this file: the extension is linked against
+  build/libdem.a, compiled in parallel by make with this machine's flags, and placed in pydem/.
 
 The cdef is generated from include/dem/*.h (comments, preprocessor lines, C++ guards and the
-DEM_API export macro removed), so the binding cannot drift from the headers. Run by
-`make pydem` (and so by `make test`):
-
-    .venv/bin/python pydem/_build_ffi.py
+DEM_API export macro removed), so the binding cannot drift from the headers.
 """
 import re
 import os
@@ -55,23 +57,41 @@ def pkg_config(*args: str) -> list[str]:
         return ["-lhdf5", "-lpng"] if "--libs" in args else []
 
 
+# libdem's own flags (the Makefile's, less -Werror and -march): C99, no errno or trap semantics
+LIBDEM_CFLAGS = ["-std=c99", "-O3", "-fno-math-errno", "-fno-trapping-math", "-fopenmp", "-fvisibility=hidden"]
+
+
+def make_builder(archive: Path | None = None) -> cffi.FFI:
+    """The extension over build/libdem.a (archive given) or over libdem's sources (None; paths
+    relative to the project root, as setuptools wants them)."""
+    ffi = cffi.FFI()
+    ffi.cdef(cdef_source())
+    libs = pkg_config("--libs")
+    cflags = pkg_config("--cflags")
+    if archive is None:
+        sources = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "libdem").glob("*.c"))
+        headers = sorted(str(p.relative_to(ROOT)) for p in [*(ROOT / "libdem").glob("*.h"), *INCLUDE.glob("*.h")])
+        extra = {"sources": sources, "depends": headers,  # a changed header recompiles (setuptools checks these)
+                 "include_dirs": ["include", "libdem"], "extra_compile_args": LIBDEM_CFLAGS + cflags}
+    else:
+        extra = {"extra_objects": [str(archive)], "include_dirs": [str(ROOT / "include")],
+                 "extra_compile_args": ["-O2"] + cflags}
+    ffi.set_source(
+        "pydem._libdem",
+        '#include "dem/dem.h"',
+        library_dirs=[a[2:] for a in libs if a.startswith("-L")],
+        libraries=[a[2:] for a in libs if a.startswith("-l")] + ["m"],
+        extra_link_args=["-fopenmp"],
+        **extra,
+    )
+    return ffi
+
+
 def build() -> Path:
     archive = ROOT / "build" / "libdem.a"
     if not archive.exists():
         sys.exit(f"pydem: {archive} is missing; run `make lib` first")
-    ffi = cffi.FFI()
-    ffi.cdef(cdef_source())
-    libs = pkg_config("--libs")
-    ffi.set_source(
-        "pydem._libdem",
-        '#include "dem/dem.h"',
-        include_dirs=[str(ROOT / "include")],
-        extra_objects=[str(archive)],
-        library_dirs=[a[2:] for a in libs if a.startswith("-L")],
-        libraries=[a[2:] for a in libs if a.startswith("-l")] + ["m"],
-        extra_compile_args=["-O2"] + pkg_config("--cflags"),
-        extra_link_args=["-fopenmp"],
-    )
+    ffi = make_builder(archive)
     tmp = ROOT / "build" / "pydem"
     built = Path(ffi.compile(tmpdir=str(tmp), verbose=False))
     target = ROOT / "pydem" / built.name
@@ -85,3 +105,5 @@ def build() -> Path:
 
 if __name__ == "__main__":
     print(f"pydem: built {build().relative_to(ROOT)}")
+else:  # imported by setuptools (cffi_modules)
+    ffibuilder = make_builder()

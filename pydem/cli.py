@@ -40,7 +40,9 @@ class ProgressLine:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import LIBDEM_VERSION, __version__
     ap = argparse.ArgumentParser(prog="pydem", description="libdem/pydem: DEM lab-test rigs for calibrating bulk solids")
+    ap.add_argument("--version", action="version", version=f"pydem {__version__} (libdem {LIBDEM_VERSION})")
     sub = ap.add_subparsers(dest="command", required=True)
     rig = sub.add_parser("rig", help="run a lab-test rig")
     rig.add_argument("name", choices=sorted(RIGS), help="which rig")

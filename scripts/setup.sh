@@ -1,38 +1,49 @@
 #!/bin/sh
-# Project set-up, idempotent and quick when already done: system packages (apt) and the
-# Python environment in .venv. Called by `make test`, `make demo` and `make bench`.
+# Project set-up, idempotent and quick when already done: the system libraries (installed with
+# apt-get only where they are missing and this is Debian/Ubuntu; elsewhere it says what to
+# install) and the Python environment in .venv, with pydem installed editable (pyproject.toml)
+# and its extras. Called by `make test`, `make demo` and `make bench`.
 set -e
 cd "$(dirname "$0")/.."
 
-SYS_PKGS="libhdf5-dev libpng-dev libcmocka-dev pkg-config valgrind"
+# what the build and the tests need, checked by what they use rather than by package names
 missing=""
-for p in $SYS_PKGS; do
-    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
-done
+pkg-config --version >/dev/null 2>&1 || missing="$missing pkg-config"
+pkg-config --exists hdf5-serial 2>/dev/null || pkg-config --exists hdf5 2>/dev/null || missing="$missing libhdf5-dev"
+pkg-config --exists libpng 2>/dev/null || missing="$missing libpng-dev"
+[ -f /usr/include/cmocka.h ] || [ -f /usr/local/include/cmocka.h ] || missing="$missing libcmocka-dev"
+command -v valgrind >/dev/null 2>&1 || missing="$missing valgrind"
 if [ -n "$missing" ]; then
-    echo "setup: installing system packages:$missing"
+    if ! command -v apt-get >/dev/null 2>&1; then
+        echo "setup: missing:$missing (Debian package names)." >&2
+        echo "setup: install HDF5 and libpng with their headers and pkg-config files, cmocka and valgrind" >&2
+        echo "       with this system's package manager, then run make again." >&2
+        exit 1
+    fi
     SUDO=""
-    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    if [ "$(id -u)" -ne 0 ]; then
+        command -v sudo >/dev/null 2>&1 || { echo "setup: missing:$missing; run as root: apt-get install$missing" >&2; exit 1; }
+        SUDO="sudo"
+    fi
+    echo "setup: installing system packages:$missing"
     $SUDO apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
 fi
 
-REQ=scripts/requirements.txt
-STAMP=.venv/.requirements-stamp
 if [ ! -x .venv/bin/python ]; then
     echo "setup: creating .venv"
     python3 -m venv .venv
 fi
-if [ ! -f "$STAMP" ] || ! cmp -s "$REQ" "$STAMP"; then
-    echo "setup: installing Python packages from $REQ"
+# pydem editable with every extra: the build tools first (no build isolation: nothing to download
+# twice), then the package; redone when pyproject.toml or the build tools change
+STAMP=.venv/.pydem-stamp
+if [ ! -f "$STAMP" ] || ! cat scripts/requirements.txt pyproject.toml | cmp -s - "$STAMP"; then
+    echo "setup: installing pydem (editable) and its dependencies into .venv"
     .venv/bin/python -m pip install -q --upgrade pip
-    .venv/bin/python -m pip install -q -r "$REQ"
-    cp "$REQ" "$STAMP"
-fi
-# `import pydem` from anywhere with .venv/bin/python, and a `pydem` command
-SITE=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-[ -f "$SITE/pydem-repo.pth" ] || pwd > "$SITE/pydem-repo.pth"
-if [ ! -x .venv/bin/pydem ]; then
-    printf '#!/bin/sh\nexec "$(dirname "$0")/python" -m pydem "$@"\n' > .venv/bin/pydem
-    chmod +x .venv/bin/pydem
+    .venv/bin/python -m pip install -q -r scripts/requirements.txt
+    # an environment made by an older set-up: its path file and shell wrapper go
+    SITE=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+    rm -f "$SITE/pydem-repo.pth" .venv/bin/pydem
+    .venv/bin/python -m pip install -q --no-build-isolation -e ".[nn,dask,test]"
+    cat scripts/requirements.txt pyproject.toml > "$STAMP"
 fi
