@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 
 from nn.export import read_weights  # noqa: E402
 from pydem.mlp import NativeMLP, screen  # noqa: E402
-from pydem.screening import combinations  # noqa: E402
+from pydem.campaign.design import design_points  # noqa: E402
 
 
 def best_of(fn, repeats):
@@ -45,10 +45,16 @@ def main():
     if not files:
         sys.exit(f"no nets in {a.nets}: run `make demo` first (it trains and exports them)")
     native = [NativeMLP(f) for f in files]
+    # one screening evaluates nets over the same inputs: the largest group of nets sharing them
+    groups = {}
+    for f, n in zip(files, native):
+        groups.setdefault(tuple(n.input_names), []).append(f)
+    files = max(groups.values(), key=len)
+    native = [NativeMLP(f) for f in files]
     torch_nets = [read_weights(f) for f in files]
     names = native[0].input_names
     box = {n: (float(torch_nets[0].x_scaler.lo[j]), float(torch_nets[0].x_scaler.hi[j])) for j, n in enumerate(names)}
-    x = combinations(box, a.samples, seed=7)
+    x = design_points("sobol", box, 0, a.samples, 7)
     hidden = [n.hidden for n in native]
     print(f"{len(native)} nets (hidden {hidden}), {a.samples:,} inputs of {len(names)} parameters")
     # agreement first: a fast wrong answer is worth nothing

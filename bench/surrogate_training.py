@@ -89,8 +89,8 @@ def main():
     if a.metrics:
         metrics = a.metrics.split(",")
     else:
-        from pydem.calibrate import property_metrics
-        metrics = property_metrics(s.spec.rig, s)
+        from pydem.calibration.quantities import QUANTITIES
+        metrics = [m for m in s.metric_names if m in QUANTITIES[s.spec.rig] or m.startswith("mu_ie_s_")]
     lo = np.array([s.spec.ranges[n][0] for n in s.spec.names])
     hi = np.array([s.spec.ranges[n][1] for n in s.spec.names])
     print(f"{a.store}: {int((s.status == DONE).sum())} runs used; parameters {', '.join(s.spec.names)}")

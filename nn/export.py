@@ -21,38 +21,69 @@ Weights file (one keyword per line, values separated by spaces):
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import torch
 
-from .mlp import MLP, PropertyNet, Scaler
+
+@dataclass
+class NetArrays:
+    """What an exported net is: a name, its inputs with their scaling box, the output scaling
+    and the weights of one tanh hidden layer. Made from a trained PropertyNet (torch) or from
+    a cached surrogate (pydem.calibration.surrogates.QuantityNet, numpy): export needs no torch."""
+    name: str
+    unit: str
+    input_names: list[str]
+    lo: np.ndarray
+    hi: np.ndarray
+    y_lo: float
+    y_hi: float
+    w1: np.ndarray   # hidden x inputs
+    b1: np.ndarray
+    w2: np.ndarray   # hidden
+    b2: float
+
+    @property
+    def hidden(self) -> int:
+        return int(len(self.b1))
 
 
 def _hex(values) -> str:
     return " ".join(float(v).hex() for v in np.ravel(values))
 
 
-def weights(net: PropertyNet) -> dict[str, np.ndarray]:
+def arrays_of(net) -> NetArrays:
+    """NetArrays of a PropertyNet (or the NetArrays given)."""
+    if isinstance(net, NetArrays):
+        return net
     m = net.model
-    return {"w1": m.hidden.weight.detach().numpy().copy(), "b1": m.hidden.bias.detach().numpy().copy(),
-            "w2": m.out.weight.detach().numpy()[0].copy(), "b2": m.out.bias.detach().numpy().copy()}
+    return NetArrays(net.name, net.unit, list(net.input_names), net.x_scaler.lo, net.x_scaler.hi,
+                     float(net.y_scaler.lo[0]), float(net.y_scaler.hi[0]), m.hidden.weight.detach().numpy().copy(),
+                     m.hidden.bias.detach().numpy().copy(), m.out.weight.detach().numpy()[0].copy(),
+                     float(m.out.bias.detach().numpy()[0]))
 
 
-def write_weights(net: PropertyNet, path: str | Path) -> Path:
-    w = weights(net)
-    lines = ["dem-mlp 1", f"name {net.name}", f"unit {net.unit or '-'}",
-             f"inputs {len(net.input_names)} {' '.join(net.input_names)}", f"hidden {net.hidden}",
-             f"input_lo {_hex(net.x_scaler.lo)}", f"input_hi {_hex(net.x_scaler.hi)}",
-             f"output_lo {_hex(net.y_scaler.lo)}", f"output_hi {_hex(net.y_scaler.hi)}",
-             f"w1 {_hex(w['w1'])}", f"b1 {_hex(w['b1'])}", f"w2 {_hex(w['w2'])}", f"b2 {_hex(w['b2'])}"]
+def weights_text(net) -> str:
+    """The "dem-mlp 1" text of a PropertyNet or NetArrays (libdem's dem_mlp_parse reads it)."""
+    a = arrays_of(net)
+    lines = ["dem-mlp 1", f"name {a.name}", f"unit {a.unit or '-'}",
+             f"inputs {len(a.input_names)} {' '.join(a.input_names)}", f"hidden {a.hidden}",
+             f"input_lo {_hex(a.lo)}", f"input_hi {_hex(a.hi)}", f"output_lo {_hex(a.y_lo)}", f"output_hi {_hex(a.y_hi)}",
+             f"w1 {_hex(a.w1)}", f"b1 {_hex(a.b1)}", f"w2 {_hex(a.w2)}", f"b2 {_hex(a.b2)}"]
+    return "\n".join(lines) + "\n"
+
+
+def write_weights(net, path: str | Path) -> Path:
     path = Path(path)
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(weights_text(net))
     return path
 
 
-def read_weights(path: str | Path) -> PropertyNet:
-    """The inverse of write_weights (exact)."""
+def read_weights(path: str | Path):
+    """The inverse of write_weights (exact): a PropertyNet (needs torch)."""
+    import torch
+    from .mlp import MLP, PropertyNet, Scaler
     fields = {}
     for n, line in enumerate(Path(path).read_text().splitlines(), 1):
         parts = line.split()
@@ -80,17 +111,19 @@ def c_identifier(name: str) -> str:
     return ident if ident and not ident[0].isdigit() else "net_" + ident
 
 
-def write_c(net: PropertyNet, directory: str | Path, prefix: str = "mlp_") -> tuple[Path, Path]:
-    """<prefix><name>.h / .c: `double <prefix><name>(const double x[N])` in physical units."""
+def write_c(net, directory: str | Path, prefix: str = "mlp_") -> tuple[Path, Path]:
+    """<prefix><name>.h / .c: `double <prefix><name>(const double x[N])` in physical units
+    (net: a PropertyNet or NetArrays)."""
+    net = arrays_of(net)
     ident = prefix + c_identifier(net.name)
-    w = weights(net)
+    w = {"w1": net.w1, "b1": net.b1, "w2": net.w2, "b2": np.array([net.b2])}
     nin, hid = len(net.input_names), net.hidden
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     guard = ident.upper() + "_H"
     header = f"""/* {ident}: MLP surrogate of '{net.name}'{f' [{net.unit}]' if net.unit else ''}, exported by pydem (nn/export.py).
  * Inputs (physical units, in this order): {', '.join(net.input_names)}.
- * Trained on inputs within: {', '.join(f'{n} [{lo:g}, {hi:g}]' for n, lo, hi in zip(net.input_names, net.x_scaler.lo, net.x_scaler.hi))};
+ * Trained on inputs within: {', '.join(f'{n} [{lo:g}, {hi:g}]' for n, lo, hi in zip(net.input_names, net.lo, net.hi))};
  * outside that box it extrapolates. C99, needs <math.h> (link with -lm). */
 #ifndef {guard}
 #define {guard}
@@ -114,10 +147,10 @@ double {ident}(const double x[{nin}]);
 #include "{ident}.h"
 #include <math.h>
 
-{arr('input_lo', net.x_scaler.lo)}{arr('input_hi', net.x_scaler.hi)}{arr('w1', w['w1'])}{arr('b1', w['b1'])}{arr('w2', w['w2'])}
+{arr('input_lo', net.lo)}{arr('input_hi', net.hi)}{arr('w1', w['w1'])}{arr('b1', w['b1'])}{arr('w2', w['w2'])}
 double {ident}(const double x[{nin}])
 {{
-    const double output_lo = {float(net.y_scaler.lo[0]).hex()}, output_hi = {float(net.y_scaler.hi[0]).hex()};
+    const double output_lo = {float(net.y_lo).hex()}, output_hi = {float(net.y_hi).hex()};
     const double b2 = {float(w['b2'][0]).hex()};
     double xs[{nin}], y = b2;
     int i, j;

@@ -54,11 +54,11 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--frames", help="directory for PNG frames")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
-    from . import calibrate, cli_campaign, cli_compare, cli_diagnose
+    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose
     cli_campaign.add_parser(sub)
     cli_compare.add_parser(sub)
     cli_diagnose.add_parser(sub)
-    calibrate.add_parser(sub)
+    cli_calibrate.add_parser(sub)
     return ap
 
 

@@ -1,51 +1,66 @@
-"""`pydem compare`: a model (the surrogate nets at a parameter set, or DEM results) against a
-measurement file: residual table with z-scores, overall error, plot.
+"""`pydem compare`: a given model against a measurement file, row by row at each row's condition
+— the surrogates of the campaign stores at a parameter set, or DEM rig results.
 
-    pydem compare data/measurements/glass_microbeads.csv --material glass_microbeads \\
-        --nets build/calibration/nets --params friction=0.3,rolling_friction=0.05,restitution=0.5
-    pydem compare data/measurements/glass_microbeads.csv --material glass_microbeads --dem result.json
+    pydem compare data/measurements/synthetic_cohesive.csv --material synthetic_cohesive \\
+        --params friction=0.5,rolling_friction=0.2,restitution=0.5
+    pydem compare MEAS.csv --material M --dem ring_shear_2kPa.json --dem aor.json
 """
 from __future__ import annotations
 
+import math
 import sys
 
 
 def add_parser(sub):
-    p = sub.add_parser("compare", help="model vs measurements: residuals, z-scores, overall error, plot")
+    from .calibration.setup import DEFAULT_STORES
+    p = sub.add_parser("compare", help="a model vs measurements, row by row at each condition: residuals, z, overall error")
     p.add_argument("measurements")
     p.add_argument("--material", required=True)
-    p.add_argument("--nets", help="directory of exported nets (<rig>__<metric>.mlp)")
-    p.add_argument("--params", help="parameter set for the nets: name=value,name=value")
+    p.add_argument("--params", help="the surrogates at this parameter set: name=value,name=value")
+    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES), help="campaign stores of the surrogates")
     p.add_argument("--dem", action="append", default=[], help="rig result JSON (pydem rig ... --out r.json); repeatable")
-    p.add_argument("--plot", help="PNG path for the plot")
     p.set_defaults(func=main)
 
 
+def _params(text: str) -> dict[str, float]:
+    out = {}
+    for item in text.split(","):
+        if "=" not in item:
+            raise ValueError(f"--params: expected name=value, got {item!r}")
+        k, v = item.split("=", 1)
+        out[k.strip()] = float(v)
+        if not math.isfinite(out[k.strip()]):
+            raise ValueError(f"--params: {k.strip()} is not a finite number")
+    return out
+
+
 def main(args) -> int:
-    from . import compare as cmp
-    from .measurements import MeasurementError, load
+    from .calibration.compare import dem_rows, overall, surrogate_rows
+    from .calibration.quantities import ObservationError
+    from .calibration.setup import load_setup, observations_from_file
+    from .campaign import StoreError
+    from .measurements import MeasurementError, load as load_measurements
+    say = lambda msg: print(msg, flush=True)  # noqa: E731
+    if bool(args.params) == bool(args.dem):
+        print("pydem compare: give --params (the surrogates at a parameter set) or --dem result files", file=sys.stderr)
+        return 2
     try:
-        meas = load(args.measurements, args.material)
-        if args.nets:
-            if not args.params:
-                raise ValueError("--nets needs --params name=value,...")
-            params = {}
-            for item in args.params.split(","):
-                if "=" not in item:
-                    raise ValueError(f"--params: expected name=value, got {item!r}")
-                k, v = item.split("=", 1)
-                params[k.strip()] = float(v)
-            model = cmp.surrogate_model(args.nets, params)
-        elif args.dem:
-            model = cmp.dem_model(args.dem)
+        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
+        setup = load_setup(args.stores, say)
+        obs, skipped = observations_from_file(args.measurements, args.material, setup)
+        if args.params:
+            rows, unmatched = surrogate_rows(obs, setup, _params(args.params)), []
         else:
-            raise ValueError("give --nets with --params, or --dem result files")
-    except (MeasurementError, ValueError, OSError, KeyError) as exc:
+            rows, unmatched = dem_rows(obs, args.dem)
+    except (MeasurementError, ObservationError, StoreError, ValueError, OSError, KeyError) as exc:
         print(f"pydem compare: {exc}", file=sys.stderr)
         return 2
-    res = cmp.compare(meas, model)
-    print(cmp.table_markdown(res))
-    if args.plot:
-        cmp.plot(res, args.plot, f"{args.material}: model vs measurements")
-        print(f"plot written to {args.plot}")
+    print("| measurement | measured | u | model | sigma | z | relative |\n|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['label']} | {r['measured']:.4g} | {r['u_measured']:.3g} | {r['model']:.4g} | {r['sigma']:.3g} | "
+              f"{r['z']:+.2f} | {100 * r['relative']:+.1f} % |")
+    o = overall(rows)
+    print(f"\n{o['n']} rows: RMSE of relative residuals {o['rmse_relative']:.3f}, chi^2 per row {o['chi2_per_value']:.2f}")
+    for line in skipped + unmatched:
+        print(f"left out: {line}")
     return 0

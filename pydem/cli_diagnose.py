@@ -29,10 +29,11 @@ def main(args) -> int:
     from .calibration.quantities import ObservationError
     from .calibration.setup import load_setup, observations_from_file
     from .campaign import StoreError
-    from .measurements import MeasurementError
+    from .measurements import MeasurementError, load as load_measurements
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     try:
+        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
         setup = load_setup(args.stores, say, args.retrain)
         obs, skipped = observations_from_file(args.measurements, args.material, setup)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
@@ -53,20 +54,10 @@ def main(args) -> int:
                "stores": {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem")}
                           for r, s in setup.stores.items()}, "libdem_of_stores": setup.physics}
     if args.confirm:
-        from .calibration.synthetic import rig_values
-        fit, model = (d.after, d.after_model) if d.after is not None else (d.base, d.base_model)
-        inputs = {}
-        for c in setup.candidates:
-            inputs[c.parameter] = c.neutral_value(fit.as_dict())
-        inputs.update(fit.as_dict())
-        say(f"confirming DEM runs at the final estimate ({len({(o.quantity.rig, str(o.conditions)) for o in obs})} "
-            f"condition groups at most)")
+        from .calibration.confirm import confirm
         from .cli import ProgressLine
-        values = rig_values(setup.stores, inputs, obs, seed=12345, threads=args.threads, say=say, progress=ProgressLine())
-        context["confirm"] = [{"label": obs[i].label, "measured": obs[i].value, "dem": v,
-                               "relative": (obs[i].value - v) / obs[i].value} for i, v in sorted(values.items())]
-        for row in context["confirm"]:
-            say(f"  {row['label']:60s} measured {row['measured']:.4g}  DEM {row['dem']:.4g}  ({100 * row['relative']:+.1f} %)")
+        fit = d.after if d.after is not None else d.base
+        context["confirm"] = confirm(setup, fit, obs, args.threads, say, ProgressLine())
     path = report.write(d, args.out, context)
     say(f"verdict: {d.verdict}" + (f" ({d.effect})" if d.effect else "") + f" — {report.verdict_line(d)}")
     say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")

@@ -25,11 +25,17 @@ def _call(fn, *args):
 class NativeMLP:
     """A net loaded by libdem from a "dem-mlp 1" weights file (nn/export.py)."""
 
-    def __init__(self, path: str | Path):
+    def __init__(self, path: str | Path | None = None, text: str | None = None):
+        """From a weights file, or from the same text in memory (`text=`)."""
+        if (path is None) == (text is None):
+            raise ValueError("NativeMLP: give a weights file path or its text, not both")
         out = _ffi.new("dem_mlp **")
-        _call(_lib.dem_mlp_load, str(path).encode(), out)
+        if text is not None:
+            _call(_lib.dem_mlp_parse, text.encode(), out)
+        else:
+            _call(_lib.dem_mlp_load, str(path).encode(), out)
         self._ptr = _ffi.gc(out[0], _lib.dem_mlp_free)
-        self.path = Path(path)
+        self.path = Path(path) if path is not None else None
 
     @property
     def name(self) -> str:

@@ -25,6 +25,7 @@ import numpy as np
 from scipy import stats
 
 from .candidates import Candidate
+from .calibrate import fit_base, fit_summary, residual_table, window_screen
 from .fit import Fit, Model, minimise, posterior
 from .quantities import Observation
 
@@ -75,25 +76,16 @@ class Diagnosis:
     loco: dict                   # leave-one-condition-out relative RMSE, before/after
     notes: list[str] = field(default_factory=list)
     testable: bool = True        # more measurements than base parameters: candidates could be tested
+    window: dict = field(default_factory=dict)  # seed 000's ±5 % admissible set of the final model
 
     def summary_of(self, fit: Fit | None, model: Model | None) -> dict | None:
         if fit is None:
             return None
-        pred = model.predict(fit.best)
-        rel = (model.y - pred) / model.y
-        return {"chi2": fit.chi2, "chi2_per_dof": fit.chi2_per_dof, "dof": fit.dof, "p_value": fit.p_value,
-                "rmse_relative": float(np.sqrt(np.mean(rel ** 2))), "n": fit.n, "bic": fit.bic,
-                "loco_rmse_relative": self.loco.get("after" if model is self.after_model else "before")}
+        return fit_summary(model, fit) | {"loco_rmse_relative": self.loco.get("after" if model is self.after_model else "before")}
 
     def residual_table(self, after: bool = False) -> list[dict]:
         fit, model = (self.after, self.after_model) if after else (self.base, self.base_model)
-        pred = model.predict(fit.best)
-        rows = []
-        for o, f, s, net in zip(self.observations, pred, model.sigma, model.nets):
-            rows.append({"quantity": o.quantity.key, "conditions": o.conditions, "label": o.label,
-                         "measured": o.value, "u_measured": o.uncertainty, "model": float(f), "u_model": net.net_error, "scatter": net.seed_sd, "sigma": float(s),
-                         "z": float((o.value - f) / s), "relative": float((o.value - f) / o.value)})
-        return rows
+        return residual_table(self.observations, model, fit)
 
     def as_dict(self) -> dict:
         params = {}
@@ -109,7 +101,7 @@ class Diagnosis:
                 "after": self.summary_of(self.after, self.after_model),
                 "parameters": params, "base_parameters": {n: v for n, v in self.base.posterior.get("parameters", {}).items()},
                 "correlation": {"names": final.posterior.get("names"), "matrix": final.posterior.get("correlation")},
-                "admissible_window": final.posterior.get("admissible_window"),
+                "admissible_window": self.window,
                 "similarity": self.similarity, "separating_condition": self.separating,
                 "groups": self.groups, "residuals_before": self.residual_table(False),
                 "residuals_after": self.residual_table(True) if self.after is not None else None,
@@ -212,7 +204,7 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     not_covered = [c.name for c in candidates if c not in covered]
     notes = []
     n = len(observations)
-    base_model = Model(observations, nets, ranges, covered)
+    base_model, base = fit_base(observations, nets, ranges, covered)
     testable = n > len(base_model.free)
     if not testable:
         notes.append(f"{n} usable measurement(s) for {len(base_model.free)} base parameters: the base model is "
@@ -221,8 +213,6 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         covered_for_tests = []
     else:
         covered_for_tests = covered
-    base = minimise(base_model)
-    base.posterior = posterior(base_model, base)
     say(f"  base model: chi^2/dof {base.chi2_per_dof:.2f} (p = {base.p_value:.2g}, {n} rows)")
     results, mjs = [], {}
     for c in covered_for_tests:
@@ -290,6 +280,8 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     for o in observations:
         if o.assumed:
             notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
+    final_model = after_model if after is not None else base_model
+    window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
-                     after, after_model, similarity, separating, groups, loco, notes, testable)
+                     after, after_model, similarity, separating, groups, loco, notes, testable, window)

@@ -177,13 +177,7 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     sd = np.sqrt(var)
     cov_p = ((x - mean) * w[:, None]).T @ (x - mean)
     corr = cov_p / np.outer(sd, sd)
-    # seed 000's view: the prior samples whose predictions are all within 5 % of the measured values
-    rel = np.abs(model.predict(uni) - model.y) / np.abs(model.y)
-    ok = np.all(rel <= 0.05, axis=1)
-    window = {"window": 0.05, "samples": int(len(uni)), "admissible": int(ok.sum()),
-              "ranges": {n: [float(uni[ok, j].min()), float(uni[ok, j].max())] for j, n in enumerate(fit.names)} if ok.any() else {}}
-    out = {"samples": int(len(x)), "ess": ess, "parameters": {}, "correlation": corr.tolist(), "names": fit.names,
-           "admissible_window": window}
+    out = {"samples": int(len(x)), "ess": ess, "parameters": {}, "correlation": corr.tolist(), "names": fit.names}
     for j, name in enumerate(fit.names):
         order = np.argsort(x[:, j])
         cw = np.cumsum(w[order])

@@ -55,6 +55,13 @@ class Observation:
         return ", ".join(f"{k}={v:g}" + (" (assumed)" if k in self.assumed else "") for k, v in self.conditions.items())
 
 
+def rig_metric(o: Observation) -> str:
+    """The rig result's metric that measures the observation (mu_ie_s at fraction 0.6: mu_ie_s_60)."""
+    if o.quantity.metric == "mu_ie_s":
+        return f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
+    return o.quantity.metric
+
+
 class ObservationError(ValueError):
     """A measurement that the surrogates cannot represent (named with its line)."""
 
@@ -105,8 +112,10 @@ def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.nda
                 frac = int(hit.group(1)) / 100.0
                 xs.append(np.column_stack([store.params[ok], np.full(ok.sum(), frac)]))
                 ys.append(store.values[ok, j])
-            if xs:
+            if len(xs) > 1:
                 out[q] = (names + ["shear_fraction"], np.vstack(xs), np.concatenate(ys))
+            elif xs:  # one shear point: the fraction is a fixed condition of the store, not an input
+                out[q] = (names, xs[0][:, :-1], ys[0])
             continue
         if metric not in store.metric_names:
             continue
@@ -117,12 +126,15 @@ def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.nda
 
 
 def preset_conditions(store) -> dict[str, float]:
-    """The conditions of the store's preset (the defaults for rows that do not give them)."""
-    from ..rigs import RIGS, load
-    cfg = load(RIGS[store.spec.rig][1], store.spec.preset)
+    """The conditions the store's runs have when they do not vary them (its preset with the
+    campaign's fixed settings): the defaults for rows that do not give them."""
+    cfg = store.spec.config({})
     out = {}
     for cname in CONDITIONS[store.spec.rig]:
         if cname == "shear_fraction":
+            points = getattr(cfg, "shear_points", None) or []
+            if len(points) == 1:  # a single shear point is the store's fixed fraction
+                out[cname] = float(points[0])
             continue
         v = getattr(cfg, cname, None)
         if v is not None:

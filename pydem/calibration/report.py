@@ -48,42 +48,41 @@ def _axis_condition(q) -> str | None:
     return {"ring-shear": "preshear_stress", "hopper": "slot_width"}.get(q.rig)
 
 
-def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
-    """Measured (error bars: the row's sigma) and model before/after against each quantity's condition."""
+def plot_measured_vs_model(observations, sigma, models: dict[str, np.ndarray]) -> bytes:
+    """Measured (error bars: each row's sigma) and each model's predictions ({label: values}; the
+    first dashed, the others solid) against each quantity's condition, one panel per quantity."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.ticker
-    before = d.base_model.predict(d.base.best)
-    after = d.after_model.predict(d.after.best) if d.after is not None else None
-    quantities = sorted({o.quantity for o in d.observations}, key=lambda q: q.key)
+    quantities = sorted({o.quantity for o in observations}, key=lambda q: q.key)
     n = len(quantities)
     cols = min(3, n)
     rows = int(math.ceil(n / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows), squeeze=False, layout="constrained")
     for ax, q in zip(axes.flat, quantities):
-        idx = [i for i, o in enumerate(d.observations) if o.quantity == q]
+        idx = [i for i, o in enumerate(observations) if o.quantity == q]
         cname = _axis_condition(q)
         series = {}
         for i in idx:
-            o = d.observations[i]
+            o = observations[i]
             key = f"f = {o.conditions['shear_fraction']:g}" if "shear_fraction" in o.conditions else ""
             series.setdefault(key, []).append(i)
         for k, (label, ii) in enumerate(sorted(series.items())):
-            x = np.array([d.observations[i].conditions.get(cname, k) if cname else k for i in ii], dtype=float)
+            x = np.array([observations[i].conditions.get(cname, k) if cname else k for i in ii], dtype=float)
             order = np.argsort(x)
             x = x[order]
             ii = [ii[j] for j in order]
             col = f"C{k}"
-            ax.errorbar(x, [d.observations[i].value for i in ii], yerr=[d.base_model.sigma[i] for i in ii], fmt="o",
+            ax.errorbar(x, [observations[i].value for i in ii], yerr=[sigma[i] for i in ii], fmt="o",
                         color=col, capsize=3, label=f"measured {label}".strip())
-            ax.plot(x, before[ii], "--x", color=col, alpha=0.8, label=f"base model {label}".strip())
-            if after is not None:
-                ax.plot(x, after[ii], "-+", color=col, ms=10, label=f"with {d.effect or 'best candidate'} {label}".strip())
+            for m, (name, pred) in enumerate(models.items()):
+                ax.plot(x, pred[ii], "--x" if m == 0 else "-+", color=col, alpha=0.8 if m == 0 else 1.0,
+                        ms=6 if m == 0 else 10, label=f"{name} {label}".strip())
         ax.set_title(q.key, fontsize=10)
         if cname == "preshear_stress":
             ax.set_xscale("log")
-            ax.set_xticks(sorted({d.observations[i].conditions[cname] for i in idx}))
+            ax.set_xticks(sorted({observations[i].conditions[cname] for i in idx}))
             ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
             ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         elif cname is None:
@@ -93,7 +92,18 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     fig.suptitle("measured (bars: 1 sigma incl. seed scatter and net error) vs model", fontsize=10)
-    out = {"residuals.png": _png(fig)}
+    return _png(fig)
+
+
+def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
+    """The measured-vs-model plot (base model, and with the effect) and the candidates' statistics."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    models = {"base model": d.base_model.predict(d.base.best)}
+    if d.after is not None:
+        models[f"with {d.effect or 'best candidate'}"] = d.after_model.predict(d.after.best)
+    out = {"residuals.png": plot_measured_vs_model(d.observations, d.base_model.sigma, models)}
     fig, ax = plt.subplots(figsize=(5.5, 0.5 + 0.45 * max(len(d.candidates), 1)))
     names = [c.effect for c in d.candidates][::-1]
     vals = [c.statistic for c in d.candidates][::-1]
@@ -158,37 +168,61 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
                       + ", ".join(f"{kk}={vv:.4g}" for kk, vv in s["conditions"].items())
                       + f" (the two explanations differ there by {s['difference_in_sigma']:.1f} sigma).")
     sections.append(("Candidate effects", md + extra, h + "".join(f"<p>{html.escape(x)}</p>" for x in extra.split("\n\n") if x)))
-    params = data["parameters"]
-    rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
-            for k, v in params.items()]
-    md, h = _table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
-    win = data.get("admissible_window") or {}
-    if win:
-        line = (f"Seed 000's view: {win['admissible']:,} of {win['samples']:,} uniform samples of the box predict every "
-                f"measured value within ±{100 * win['window']:g} %" + (": " + ", ".join(
-                    f"{k} {v[0]:.3g}–{v[1]:.3g}" for k, v in win["ranges"].items()) if win["ranges"] else "") + ".")
-        md += "\n\n" + line
-        h += f"<p>{html.escape(line)}</p>"
-    sections.append(("Parameters" + (f" (with {d.effect})" if d.after is not None else ""), md, h))
+    sections.append(parameter_section(data["parameters"], data.get("admissible_window"),
+                                      "Parameters" + (f" (with {d.effect})" if d.after is not None else "")))
     for title, key in (("Residuals, base model", "residuals_before"), ("Residuals, with the effect", "residuals_after")):
-        if not data.get(key):
-            continue
-        rows = [[r["label"], _g(r["measured"]), _g(r["u_measured"], ".3g"), _g(r["model"]), _g(r["sigma"], ".3g"),
-                 _g(r["z"], "+.2f")] for r in data[key]]
-        md, h = _table(rows, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
-        sections.append((title, md, h))
+        if data.get(key):
+            sections.append(residual_section(data[key], title))
     if d.groups:
         names = list(d.groups[0]["estimate"])
         rows = [[g["condition"], g["rows"]] + [_g(g["estimate"][n], ".3g") for n in names] for g in d.groups]
         md, h = _table(rows, ["condition group", "rows"] + names)
         sections.append(("Base model recalibrated per condition group (a parameter drifting with a condition points "
                          "at a missing effect)", md, h))
+    if data["context"].get("confirm"):
+        sections.append(confirm_section(data["context"]["confirm"]))
     if d.notes:
-        sections.append(("Notes", "\n".join(f"- {n}" for n in d.notes), "<ul>" + "".join(f"<li>{html.escape(n)}</li>"
-                                                                                        for n in d.notes) + "</ul>"))
-    title = f"Diagnosis: {d.material}"
+        sections.append(notes_section(d.notes))
+    return write_page(out, f"Diagnosis: {d.material}", sections, plots, head=2)
+
+
+def parameter_section(params: dict, window: dict | None, title: str) -> tuple[str, str, str]:
+    rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
+            for k, v in params.items()]
+    md, h = _table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
+    if window:
+        line = (f"Seed 000's view: {window['admissible']:,} of {window['samples']:,} combinations of the box (scrambled "
+                f"Sobol, screened natively) predict every measured value within ±{100 * window['window']:g} %"
+                + (": " + ", ".join(f"{k} {v[0]:.3g}–{v[1]:.3g}" for k, v in window["ranges"].items())
+                   if window["ranges"] else "") + ".")
+        md += "\n\n" + line
+        h += f"<p>{html.escape(line)}</p>"
+    return title, md, h
+
+
+def residual_section(rows: list[dict], title: str) -> tuple[str, str, str]:
+    table = [[r["label"], _g(r["measured"]), _g(r["u_measured"], ".3g"), _g(r["model"]), _g(r["sigma"], ".3g"),
+              _g(r["z"], "+.2f")] for r in rows]
+    md, h = _table(table, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
+    return title, md, h
+
+
+def confirm_section(rows: list[dict]) -> tuple[str, str, str]:
+    table = [[r["label"], _g(r["measured"]), _g(r["dem"]), f"{100 * r['relative']:+.1f} %"] for r in rows]
+    md, h = _table(table, ["measurement", "measured", "DEM at the estimate", "(measured - DEM) / measured"])
+    return "Confirming DEM runs", md, h
+
+
+def notes_section(notes: list[str]) -> tuple[str, str, str]:
+    return ("Notes", "\n".join(f"- {n}" for n in notes),
+            "<ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in notes) + "</ul>")
+
+
+def write_page(out: Path, title: str, sections: list[tuple[str, str, str]], plots: dict[str, bytes], head: int) -> Path:
+    """report.md (plots as the PNG files beside it) and report.html (self-contained: plots
+    embedded after the first `head` sections)."""
     md = f"# {title}\n\n" + "\n\n".join(f"## {t}\n\n{m}" for t, m, _ in sections)
-    md += "\n\n## Plots\n\n![measured vs model](residuals.png)\n\n![candidates](candidates.png)\n"
+    md += "\n\n## Plots\n\n" + "\n\n".join(f"![{n[:-4]}]({n})" for n in plots) + "\n"
     (out / "report.md").write_text(md)
     imgs = "".join(f"<figure><img alt='{n}' src='data:image/png;base64,{base64.b64encode(p).decode()}'></figure>"
                    for n, p in plots.items())
@@ -196,8 +230,44 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
             "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
             "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
             ".verdict{font-size:1.2em;background:#f4f4f0;padding:.6em}img{max-width:100%}</style></head><body>"
-            f"<h1>{html.escape(title)}</h1>" + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[:2])
-            + imgs + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[2:]) + "</body></html>")
+            f"<h1>{html.escape(title)}</h1>" + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[:head])
+            + imgs + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[head:]) + "</body></html>")
     path = out / "report.html"
     path.write_text(page)
     return path
+
+
+def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
+    """report.html / report.md / calibration.json of a calibration.Calibration, the measured-vs-model
+    plot, and the admissible set as CSV (the points and nothing else)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    data = c.as_dict()
+    data["context"] = context or {}
+    (out / "calibration.json").write_text(json.dumps(strict_json(data), indent=1, allow_nan=False))
+    plots = {"residuals.png": plot_measured_vs_model(c.observations, c.model.sigma,
+                                                      {"calibrated model": c.model.predict(c.fit.best)})}
+    for name, png in plots.items():
+        (out / name).write_bytes(png)
+    pts = c.screening.get("points")
+    if pts is not None:
+        np.savetxt(out / "admissible.csv", pts, delimiter=",", header=",".join(c.screening["names"]), comments="",
+                   fmt="%.10g")
+    f = data["fit"]
+    line = (f"chi^2/dof {f['chi2_per_dof']:.2f} over {f['n']} measurements ({f['dof']} dof, p = {_g(f['p_value'], '.2g')}), "
+            f"RMSE of relative residuals {f['rmse_relative']:.3f}.")
+    if f["p_value"] < 0.001:
+        line += " The model does not fit these measurements: run `pydem diagnose` to find which effect is missing."
+    sections = [("Fit", line, f"<p class='verdict'>{html.escape(line)}</p>"),
+                parameter_section(data["parameters"], data["admissible_window"], "Parameters (posterior)"),
+                residual_section(data["residuals"], "Residuals")]
+    names = data["correlation"]["names"] or []
+    if names:
+        rows = [[a] + [_g(v, "+.2f") for v in row] for a, row in zip(names, data["correlation"]["matrix"])]
+        md, h = _table(rows, ["correlation"] + names)
+        sections.append(("Posterior correlations", md, h))
+    if data["context"].get("confirm"):
+        sections.append(confirm_section(data["context"]["confirm"]))
+    if c.notes:
+        sections.append(notes_section(c.notes))
+    return write_page(out, f"Calibration: {c.material}", sections, plots, head=2)

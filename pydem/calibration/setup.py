@@ -3,6 +3,7 @@ the parameter box they share and the candidates they cover; and measurement file
 observations (rows the surrogates cannot represent are reported, never matched elsewhere)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,6 +73,13 @@ def observations_from_file(path: str | Path, material: str, setup: Setup) -> tup
                    and not net.lo[net.input_names.index(k)] <= v <= net.hi[net.input_names.index(k)]]
         if outside:
             skipped.append(f"line {m.line}: {m.label}: condition {', '.join(outside)} (the campaign's range)")
+            continue
+        # a condition the store does not vary: its runs all have one value, and the row must have it too
+        other = [f"{k}={v:g} but the campaign ran at {setup.defaults[k]:g} only" for k, v in o.conditions.items()
+                 if k not in net.input_names and k in setup.defaults
+                 and not math.isclose(v, setup.defaults[k], rel_tol=1e-6)]
+        if other:
+            skipped.append(f"line {m.line}: {m.label}: measured at {', '.join(other)} (use a store that varies it)")
             continue
         out.append(o)
     if not out:

@@ -78,6 +78,17 @@ class QuantityNet:
         g = ((1.0 - h * h) * self.w2) @ self.w1  # d y_s / d s
         return g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
 
+    @property
+    def name(self) -> str:
+        """File and C name: ring_shear__mu_ie_s."""
+        return f"{self.quantity.rig.replace('-', '_')}__{self.quantity.metric}"
+
+    def export_arrays(self):
+        """The net as nn.export.NetArrays (weights file for libdem, standalone C)."""
+        from nn.export import NetArrays
+        return NetArrays(self.name, self.unit, list(self.input_names), self.lo, self.hi, self.y_lo, self.y_hi,
+                         self.w1, self.b1, self.w2, self.b2)
+
     def to_arrays(self) -> dict:
         return {"lo": self.lo, "hi": self.hi, "w1": self.w1, "b1": self.b1, "w2": self.w2,
                 "meta": np.array(json.dumps({"rig": self.quantity.rig, "metric": self.quantity.metric,

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation, Quantity
+from .quantities import Observation, Quantity, rig_metric
 
 NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
          "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
@@ -154,11 +154,9 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
         jammed = rig == "hopper" and not (dt is not None and math.isfinite(dt.value))
         for i in idx:
             o = obs[i]
-            metric = o.quantity.metric
+            metric = rig_metric(o)
             if jammed and metric in ("mass_flow_rate", "discharge_time"):
                 continue  # a hopper that jammed measured neither a flow rate nor a discharge time
-            if metric == "mu_ie_s":
-                metric = f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
             v = res.metrics[metric].value if metric in res.metrics else None
             if isinstance(v, float) and math.isfinite(v) and v > 0:
                 values[i] = v

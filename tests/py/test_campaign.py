@@ -156,19 +156,6 @@ def test_replicates_grow_by_replicate_and_average_per_point(tmp_path):
     assert np.array_equal(x, s.params[[0, 1, 2, 6, 7]])
     # pooled sd of one run: deviations +-0.5, 0, +-1 over 3 degrees of freedom
     assert sd == pytest.approx(np.sqrt((2 * 0.25 + 2 * 1.0) / 3), rel=1e-12)
-    # noise ceiling on the means: 1 - sd^2 mean(1/count) / var(means)
-    from pydem.calibrate import noise_ceiling
-    ceiling, source = noise_ceiling(s, "m")
-    assert source == "replicates"
-    assert ceiling == pytest.approx(1 - sd**2 * np.mean([1 / 2, 1 / 2, 1 / 2, 1, 1]) / np.var(y), rel=1e-12)
-    # one run per point with their own standard errors (repeats inside a run): those are the noise
-    one = Campaign.create(tmp_path / "one.h5", spec(samples=4)).store
-    for i, (v, u) in enumerate([(1.0, 0.1), (2.0, 0.2), (4.0, 0.1), (3.0, 0.2)]):
-        one.record_done(i, {"m": (v, u, "")}, 1.0)
-    ceiling, source = noise_ceiling(one, "m")
-    assert source == "within-run" and ceiling == pytest.approx(1 - np.mean([0.01, 0.04]) / np.var([1, 2, 4, 3]), rel=1e-12)
-    one.record_done(3, {"m": (3.0, float("nan"), "")}, 1.0)  # no error known for a run: no ceiling
-    assert noise_ceiling(one, "m")[1] == "" and np.isnan(noise_ceiling(one, "m")[0])
     # a store written before replicates (format 1, no `point`) reads as one run per point
     import h5py
     with h5py.File(tmp_path / "r.h5", "a") as f:

@@ -66,10 +66,10 @@ def test_documented_command(argv, tmp_path):
     elif cmd in ("calibrate", "compare", "diagnose"):
         from pydem.measurements import load
         load(ROOT / args.measurements, args.material)
-        for store in getattr(args, "campaign", None) or []:
+        for store in getattr(args, "stores", None) or []:
             from pydem.campaign import Campaign
             Campaign.open(ROOT / store)
-        if cmd == "diagnose":
+        if cmd in ("diagnose", "calibrate"):
             r = subprocess.run([sys.executable, "-m", "pydem", *argv[:-2], "--out", str(tmp_path / "d")], cwd=ROOT,
                                capture_output=True, text=True, timeout=300)
             assert r.returncode == 0, r.stderr

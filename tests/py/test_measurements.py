@@ -56,22 +56,11 @@ def test_spreadsheet_csv_with_bom_and_crlf(tmp_path):
 
 def test_calibrate_refuses_measurements_that_match_no_campaign(tmp_path):
     f = write(tmp_path, "x,hopper,mass_flow_rate,0.5,0.01,kg/s,slot_width=0.05,calibrate,s\n")
-    r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", "--measurements", str(f), "--material", "x",
-                        "--campaign", str(ROOT / "data/campaigns/aor_tiny.h5"), "--out", str(tmp_path / "out"),
-                        "--no-confirm"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", str(f), "--material", "x",
+                        "--stores", str(ROOT / "data/campaigns/diag_aor_tiny.h5"), "--out", str(tmp_path / "out")],
+                       cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert r.returncode == 2, r.stdout + r.stderr
-    assert "no measurement of 'x' matches a quantity of the given campaigns" in r.stderr
+    assert "no row of 'x' can be compared with the campaigns" in r.stderr
     assert "hopper:mass_flow_rate" in r.stderr and "angle_of_repose" in r.stderr
 
 
-def test_calibrate_reports_rows_at_other_conditions(tmp_path):
-    """The seed-000 chain's campaigns run at one pre-shear stress: a row measured at another is
-    reported as left out, never matched to the campaign's condition; `unknown` is the campaign's."""
-    from pydem.calibrate import condition_mismatch
-    from pydem.campaign import Campaign
-    store = Campaign.open(ROOT / "data/campaigns/ring_shear_cell.h5").store
-    rows = load(write(tmp_path, "x,ring_shear,mu_ie_ps,0.5,0.01,,preshear_stress=5000,calibrate,s\n"
-                                "x,ring_shear,mu_ie_s,0.5,0.01,,preshear_stress=2000;shear_fraction=0.5,calibrate,s\n"
-                                "x,ring_shear,bulk_density,1500,20,kg/m^3,preshear_stress=unknown,calibrate,s\n"))
-    assert "measured at preshear_stress=5000, the campaign ring_shear_cell.h5 ran at 2000" in condition_mismatch(rows[0], store)
-    assert condition_mismatch(rows[1], store) == "" and condition_mismatch(rows[2], store) == ""

@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from nn.export import read_weights, weights, write_c, write_weights
+from nn.export import arrays_of, read_weights, weights_text, write_c, write_weights
 from nn.mlp import select_net
 from pydem.errors import DemFormatError, DemIOError
 from pydem.mlp import NativeMLP, screen
@@ -36,8 +36,13 @@ def test_weights_round_trip_exact(net, tmp_path):
     assert (native.name, native.hidden, native.input_names) == ("mu_ie_ps", net.hidden, NAMES)
     native.save(tmp_path / "b.mlp")
     back = read_weights(tmp_path / "b.mlp")
-    for k, v in weights(net).items():
-        assert np.array_equal(weights(back)[k], v), k
+    a, b = arrays_of(net), arrays_of(back)
+    for k in ("lo", "hi", "y_lo", "y_hi", "w1", "b1", "w2", "b2"):
+        assert np.array_equal(getattr(b, k), getattr(a, k)), k
+    assert weights_text(back) == weights_text(net)
+    in_memory = NativeMLP(text=weights_text(net))  # dem_mlp_parse: the same net without a file
+    x = np.random.default_rng(0).uniform(0, 1, (50, 3))
+    assert np.array_equal(in_memory(x), native(x))
     for a, b in ((net.x_scaler, back.x_scaler), (net.y_scaler, back.y_scaler)):
         assert np.array_equal(a.lo, b.lo) and np.array_equal(a.hi, b.hi)
 

@@ -1,0 +1,140 @@
+"""Calibration of the base model (`pydem calibrate`): the micro parameters from measurements over
+test conditions, with honest uncertainty.
+
+- the posterior over the base parameters (uniform prior on the campaign box; likelihood from each
+  row's uncertainty, the rig's seed-to-seed scatter and the net's error: fit.Model) with credible
+  intervals, correlations and a flag for an estimate at a range edge;
+- seed 000's view of the same data: the ±window admissible set, screened natively in libdem over
+  2^20 scrambled Sobol combinations (each observation's net evaluated at its own conditions);
+- the candidate effects' parameters, where a store varies them, sit at their neutral values
+  (`pydem diagnose` is the step that frees them).
+
+Returns a Calibration that the report renders; nothing is written here."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..campaign.design import design_points
+from .candidates import Candidate
+from .fit import Fit, Model, minimise, posterior
+from .quantities import Observation
+
+
+@dataclass
+class Calibration:
+    material: str
+    observations: list[Observation]
+    model: Model
+    fit: Fit                       # best fit, with its posterior
+    screening: dict                # seed 000's admissible set: window, samples, admissible, ranges, seconds
+    notes: list[str] = field(default_factory=list)
+
+    def residual_table(self) -> list[dict]:
+        return residual_table(self.observations, self.model, self.fit)
+
+    def summary(self) -> dict:
+        return fit_summary(self.model, self.fit)
+
+    def as_dict(self) -> dict:
+        post = self.fit.posterior
+        return {"material": self.material, "fit": self.summary(),
+                "parameters": {n: {k: v for k, v in p.items()} for n, p in post.get("parameters", {}).items()},
+                "correlation": {"names": post.get("names"), "matrix": post.get("correlation")},
+                "posterior_samples": post.get("samples"), "posterior_ess": post.get("ess"),
+                "admissible_window": {k: v for k, v in self.screening.items() if k != "points"},
+                "residuals": self.residual_table(), "notes": self.notes}
+
+
+def residual_table(observations: list[Observation], model: Model, fit: Fit) -> list[dict]:
+    """Per row: measured ± u, model, the row's sigma (u or the seed scatter, and the net's error), z."""
+    pred = model.predict(fit.best)
+    rows = []
+    for o, f, s, net in zip(observations, pred, model.sigma, model.nets):
+        rows.append({"quantity": o.quantity.key, "conditions": o.conditions, "label": o.label,
+                     "measured": o.value, "u_measured": o.uncertainty, "model": float(f), "u_model": net.net_error,
+                     "scatter": net.seed_sd, "sigma": float(s), "z": float((o.value - f) / s),
+                     "relative": float((o.value - f) / o.value)})
+    return rows
+
+
+def fit_summary(model: Model, fit: Fit) -> dict:
+    rel = (model.y - model.predict(fit.best)) / model.y
+    return {"chi2": fit.chi2, "chi2_per_dof": fit.chi2_per_dof, "dof": fit.dof, "p_value": fit.p_value,
+            "rmse_relative": float(np.sqrt(np.mean(rel ** 2))), "n": fit.n, "bic": fit.bic}
+
+
+def fit_base(observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate]) -> tuple[Model, Fit]:
+    """The base model (candidates at their neutral values) fitted, with its posterior."""
+    model = Model(observations, nets, ranges, candidates)
+    fit = minimise(model)
+    fit.posterior = posterior(model, fit)
+    return model, fit
+
+
+def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, threads: int = 2, seed: int = 7,
+                  keep_points: bool = True) -> dict:
+    """Seed 000's admissible set, natively: `samples` scrambled Sobol points of the free
+    parameters' box; a point is admissible when every observation's net, at that point and the
+    observation's conditions, predicts the measured value within ±window (relative). Each net
+    is libdem's MLP (dem_mlp_eval_many, `threads` threads) built in memory from the surrogate."""
+    from nn.export import weights_text
+    from ..mlp import NativeMLP
+    ranges = {n: (lo, hi) for n, lo, hi in zip(model.free, model.lo, model.hi)}
+    pts = design_points("sobol", ranges, 0, samples, seed)
+    t0 = time.perf_counter()
+    keep = np.ones(len(pts), bool)
+    misfit = np.zeros(len(pts))
+    natives = {}
+    for k, (net, (c, a)) in enumerate(zip(model.nets, model._maps)):
+        if id(net) not in natives:  # a net that cannot be exported (a test's closed form) runs in numpy
+            natives[id(net)] = (NativeMLP(text=weights_text(net.export_arrays())) if hasattr(net, "export_arrays")
+                                else lambda x, _threads, net=net: net(x))
+        x = c + pts @ a.T  # the net's inputs: free parameters, neutral values, this row's conditions
+        pred = natives[id(net)](x, threads)
+        keep &= np.abs(pred - model.y[k]) <= window * abs(model.y[k])
+        misfit += ((pred - model.y[k]) / model.sigma[k]) ** 2
+    seconds = time.perf_counter() - t0
+    idx = np.flatnonzero(keep)
+    pool = idx if len(idx) else np.arange(len(pts))
+    best = pts[pool[int(np.argmin(misfit[pool]))]]
+    out = {"window": window, "samples": int(len(pts)), "admissible": int(len(idx)), "seconds": seconds,
+           "rows": len(model.y), "names": list(model.free),
+           "ranges": {n: [float(pts[idx, j].min()), float(pts[idx, j].max())] for j, n in enumerate(model.free)}
+           if len(idx) else {},
+           "least_misfit": dict(zip(model.free, map(float, best))), "least_misfit_admissible": bool(len(idx))}
+    if keep_points:
+        out["points"] = pts[idx]
+    return out
+
+
+def calibrate(material: str, observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate],
+              window: float = 0.05, samples: int = 2 ** 20, threads: int = 2, say=print) -> Calibration:
+    used = {o.quantity for o in observations}
+    inputs = set().union(*(set(nets[q].input_names) for q in used))
+    covered = [c for c in candidates if c.parameter in inputs and c.parameter in ranges]
+    model, fit = fit_base(observations, nets, ranges, covered)
+    say(f"  posterior: chi^2/dof {fit.chi2_per_dof:.2f} (p = {fit.p_value:.2g}, {fit.n} rows, {len(fit.names)} "
+        f"parameters; effective sample size {fit.posterior['ess']:.0f} of {fit.posterior['samples']})")
+    for name, p in fit.posterior["parameters"].items():
+        say(f"    {name:20s} {p['estimate']:10.4g}   95 % {p['lo']:.4g} - {p['hi']:.4g}" + ("   AT RANGE EDGE" if p["at_edge"] else ""))
+    screening = window_screen(model, window, samples, threads)
+    say(f"  seed 000's view: {screening['admissible']:,} of {screening['samples']:,} combinations within "
+        f"±{100 * window:g} % of every measured value ({screening['seconds']:.2f} s natively, {threads} threads)")
+    notes = []
+    if fit.n <= len(fit.names):
+        notes.append(f"{fit.n} measurement(s) for {len(fit.names)} parameters: the posterior is the prior narrowed "
+                     f"along a few directions only; measure more conditions")
+    for name, p in fit.posterior["parameters"].items():
+        if p["at_edge"]:
+            notes.append(f"{name} sits at the edge of its campaign range [{p['range'][0]:g}, {p['range'][1]:g}] "
+                         f"(estimate {p['estimate']:.4g}, 95 % interval {p['lo']:.4g}-{p['hi']:.4g}): the campaign "
+                         f"box may be too small, or the model misses an effect (`pydem diagnose`)")
+    if covered:
+        notes.append("held at their neutral values: " + ", ".join(f"{c.name} ({c.parameter})" for c in covered))
+    for o in observations:
+        if o.assumed:
+            notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
+    return Calibration(material, observations, model, fit, screening, notes)

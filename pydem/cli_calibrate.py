@@ -1,0 +1,82 @@
+"""`pydem calibrate`: the base model's micro parameters from a measurement file over test
+conditions — posterior with credible intervals and correlations, seed 000's ±5 % admissible set
+screened natively over 2^20 combinations, the surrogates exported (libdem weights files and
+standalone C), optional confirming DEM runs — and a report (docs/diagnosis.md §3).
+
+    pydem calibrate data/measurements/glass_microbeads.csv --material glass_microbeads --out build/calibration
+"""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+
+def add_parser(sub):
+    from .calibration.setup import DEFAULT_STORES
+    p = sub.add_parser("calibrate", help="posterior of the micro parameters, seed 000's admissible set, exported nets")
+    p.add_argument("measurements", help="measurement file (docs/measurements.md)")
+    p.add_argument("--material", required=True)
+    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
+                   help="campaign stores, one per rig (default: the shipped diagnosis stores)")
+    p.add_argument("--out", default="build/calibration")
+    p.add_argument("--window", type=float, default=0.05, help="seed 000's relative acceptance window (default 0.05)")
+    p.add_argument("--samples", type=int, default=2 ** 20, help="combinations screened natively (default 2^20)")
+    p.add_argument("--threads", type=int, default=2, help="threads of the screening and the confirming runs")
+    p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the estimate, every condition")
+    p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
+    p.set_defaults(func=main)
+
+
+def export_nets(nets: dict, directory: Path) -> list[Path]:
+    """Every surrogate as a libdem weights file (<rig>__<quantity>.mlp) and a C99 pair (c/)."""
+    from nn.export import write_c, write_weights
+    directory.mkdir(parents=True, exist_ok=True)
+    out = []
+    for net in nets.values():
+        a = net.export_arrays()
+        out.append(write_weights(a, directory / f"{net.name}.mlp"))
+        write_c(a, directory / "c")
+    return out
+
+
+def main(args) -> int:
+    from .calibration import report
+    from .calibration.calibrate import calibrate
+    from .calibration.quantities import ObservationError
+    from .calibration.setup import load_setup, observations_from_file
+    from .campaign import StoreError
+    from .measurements import MeasurementError, load as load_measurements
+    t0 = time.perf_counter()
+    say = lambda msg: print(msg, flush=True)  # noqa: E731
+    if args.samples < 1 or not 0 < args.window < 1:
+        print(f"pydem calibrate: --samples must be positive and --window in (0, 1) (got {args.samples}, {args.window})",
+              file=sys.stderr)
+        return 2
+    try:
+        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
+        setup = load_setup(args.stores, say, args.retrain)
+        obs, skipped = observations_from_file(args.measurements, args.material, setup)
+    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
+        print(f"pydem calibrate: {exc}", file=sys.stderr)
+        return 2
+    for line in skipped:
+        say(f"  left out: {line}")
+    say(f"calibrating {args.material}: {len(obs)} measurements (stores: libdem {setup.physics})")
+    c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
+                  args.threads, say)
+    c.notes += [f"left out: {line}" for line in skipped]
+    out = Path(args.out)
+    files = export_nets(setup.nets, out / "nets")
+    say(f"  {len(files)} surrogates exported to {out / 'nets'} (libdem weights files, C99 sources in nets/c)")
+    from .provenance import provenance
+    context = {"provenance": provenance(), "measurements": str(args.measurements),
+               "stores": {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem")}
+                          for r, s in setup.stores.items()}, "window": args.window, "samples": args.samples}
+    if args.confirm:
+        from .calibration.confirm import confirm
+        from .cli import ProgressLine
+        context["confirm"] = confirm(setup, c.fit, obs, args.threads, say, ProgressLine())
+    path = report.write_calibration(c, out, context)
+    say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
+    return 0
