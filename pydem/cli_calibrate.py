@@ -13,18 +13,11 @@ from pathlib import Path
 
 
 def add_parser(sub):
-    from .calibration.setup import DEFAULT_STORES
+    from .cli_diagnose import add_common
     p = sub.add_parser("calibrate", help="posterior of the micro parameters, seed 000's admissible set, exported nets")
-    p.add_argument("measurements", help="measurement file (docs/measurements.md)")
-    p.add_argument("--material", required=True)
-    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
-                   help="campaign stores, one per rig (default: the shipped diagnosis stores)")
-    p.add_argument("--out", default="build/calibration")
+    add_common(p, "build/calibration", 2)
     p.add_argument("--window", type=float, default=0.05, help="seed 000's relative acceptance window (default 0.05)")
     p.add_argument("--samples", type=int, default=2 ** 20, help="combinations screened natively (default 2^20)")
-    p.add_argument("--threads", type=int, default=2, help="threads of the screening and the confirming runs")
-    p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the estimate, every condition")
-    p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
     p.set_defaults(func=main)
 
 
@@ -43,25 +36,17 @@ def export_nets(nets: dict, directory: Path) -> list[Path]:
 def main(args) -> int:
     from .calibration import report
     from .calibration.calibrate import calibrate
-    from .calibration.quantities import ObservationError
-    from .calibration.setup import load_setup, observations_from_file
-    from .campaign import StoreError
-    from .measurements import MeasurementError, load as load_measurements
+    from .cli_diagnose import load_inputs
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     if args.samples < 1 or not 0 < args.window < 1:
         print(f"pydem calibrate: --samples must be positive and --window in (0, 1) (got {args.samples}, {args.window})",
               file=sys.stderr)
         return 2
-    try:
-        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
-        setup = load_setup(args.stores, say, args.retrain)
-        obs, skipped = observations_from_file(args.measurements, args.material, setup)
-    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
-        print(f"pydem calibrate: {exc}", file=sys.stderr)
+    loaded = load_inputs(args, "calibrate", say)
+    if loaded is None:
         return 2
-    for line in skipped:
-        say(f"  left out: {line}")
+    setup, obs, skipped = loaded
     say(f"calibrating {args.material}: {len(obs)} measurements (stores: libdem {setup.physics})")
     c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
                   args.threads, say)

@@ -36,23 +36,21 @@ def _params(text: str) -> dict[str, float]:
 
 def main(args) -> int:
     from .calibration.compare import dem_rows, overall, surrogate_rows
-    from .calibration.quantities import ObservationError
-    from .calibration.setup import load_setup, observations_from_file
-    from .campaign import StoreError
-    from .measurements import MeasurementError, load as load_measurements
+    from .cli_diagnose import load_inputs
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     if bool(args.params) == bool(args.dem):
         print("pydem compare: give --params (the surrogates at a parameter set) or --dem result files", file=sys.stderr)
         return 2
+    loaded = load_inputs(args, "compare", say)
+    if loaded is None:
+        return 2
+    setup, obs, _ = loaded
     try:
-        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
-        setup = load_setup(args.stores, say)
-        obs, skipped = observations_from_file(args.measurements, args.material, setup)
         if args.params:
             rows, unmatched = surrogate_rows(obs, setup, _params(args.params)), []
         else:
             rows, unmatched = dem_rows(obs, args.dem)
-    except (MeasurementError, ObservationError, StoreError, ValueError, OSError, KeyError) as exc:
+    except (ValueError, OSError, KeyError) as exc:
         print(f"pydem compare: {exc}", file=sys.stderr)
         return 2
     print("| measurement | measured | u | model | sigma | z | relative |\n|---|---|---|---|---|---|---|")
@@ -61,6 +59,6 @@ def main(args) -> int:
               f"{r['z']:+.2f} | {100 * r['relative']:+.1f} % |")
     o = overall(rows)
     print(f"\n{o['n']} rows: RMSE of relative residuals {o['rmse_relative']:.3f}, chi^2 per row {o['chi2_per_value']:.2f}")
-    for line in skipped + unmatched:
+    for line in unmatched:
         print(f"left out: {line}")
     return 0

@@ -9,38 +9,52 @@ import sys
 import time
 
 
-def add_parser(sub):
+def add_common(p, out: str, threads: int):
+    """The arguments `pydem diagnose` and `pydem calibrate` share."""
     from .calibration.setup import DEFAULT_STORES
-    p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
     p.add_argument("measurements", help="measurement file (docs/measurements.md)")
     p.add_argument("--material", required=True)
     p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
-                   help="diagnosis campaign stores, one per rig (default: the shipped tiny ones)")
-    p.add_argument("--out", default="build/diagnosis")
+                   help="campaign stores, one per rig (default: the shipped diagnosis stores)")
+    p.add_argument("--out", default=out)
     p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
-    p.add_argument("--threads", type=int, default=1, help="OpenMP threads of the confirming runs")
+    p.add_argument("--threads", type=int, default=threads, help=f"threads of the confirming runs (default {threads})")
     p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
+
+
+def load_inputs(args, command: str, say):
+    """(setup, observations, rows left out), or None after printing why not (exit status 2)."""
+    from .calibration.quantities import ObservationError
+    from .calibration.setup import load_setup, observations_from_file
+    from .campaign import StoreError
+    from .measurements import MeasurementError, load as load_measurements
+    try:
+        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
+        setup = load_setup(args.stores, say, getattr(args, "retrain", False))
+        obs, skipped = observations_from_file(args.measurements, args.material, setup)
+    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
+        print(f"pydem {command}: {exc}", file=sys.stderr)
+        return None
+    for line in skipped:
+        say(f"  left out: {line}")
+    return setup, obs, skipped
+
+
+def add_parser(sub):
+    p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
+    add_common(p, "build/diagnosis", 1)
     p.set_defaults(func=main)
 
 
 def main(args) -> int:
     from .calibration import report
     from .calibration.diagnose import diagnose
-    from .calibration.quantities import ObservationError
-    from .calibration.setup import load_setup, observations_from_file
-    from .campaign import StoreError
-    from .measurements import MeasurementError, load as load_measurements
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
-    try:
-        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
-        setup = load_setup(args.stores, say, args.retrain)
-        obs, skipped = observations_from_file(args.measurements, args.material, setup)
-    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
-        print(f"pydem diagnose: {exc}", file=sys.stderr)
+    loaded = load_inputs(args, "diagnose", say)
+    if loaded is None:
         return 2
-    for line in skipped:
-        say(f"  left out: {line}")
+    setup, obs, skipped = loaded
     say(f"diagnosing {args.material}: {len(obs)} measurements, candidates "
         f"{', '.join(c.name for c in setup.candidates)} (stores: libdem {setup.physics})")
     try:
