@@ -52,6 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--seed", type=int, default=0)
     rig.add_argument("--out", help="result file (.h5, or JSON for any other name)")
     rig.add_argument("--frames", help="directory for PNG frames")
+    rig.add_argument("--vtk", help="directory for a VTK time series at the frame times (ParaView: open particles.pvd)")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
     from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose
@@ -80,14 +81,15 @@ def main(argv: list[str] | None = None) -> int:
     try:  # before the run, not after it: a bad path must not cost a finished run
         if args.out:
             check_writable(args.out, directory=False)
-        if args.frames:
-            check_writable(args.frames, directory=True)
+        for directory in (args.frames, args.vtk):
+            if directory:
+                check_writable(directory, directory=True)
     except OSError as exc:
         print(f"pydem: cannot write the output: {exc}", file=sys.stderr)
         return 2
     progress = None if args.quiet else ProgressLine()
     try:
-        result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress)
+        result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress, vtk_dir=args.vtk)
     except (DemError, ValueError) as exc:
         if progress:
             progress.done()

@@ -306,6 +306,19 @@ class Domain:
     def write_snapshot(self, path: str | os.PathLike):
         self._check(lib.dem_snapshot_write(self._d, os.fsencode(path)))
 
+    def write_vtk(self, path: str | os.PathLike):
+        """The particles as a VTK .vtu file (ParaView): radius, velocity, angular_velocity, force,
+        id, material per sphere; the domain time as the field TIME."""
+        self._check(lib.dem_vtk_write_particles(self._d, os.fsencode(path)))
+
+    @property
+    def mesh_wall_count(self) -> int:
+        return int(lib.dem_mesh_wall_count(self._d))
+
+    def write_mesh_vtk(self, mesh: int, path: str | os.PathLike):
+        """Mesh wall `mesh` at its current pose as a VTK .vtu file, with each triangle's force."""
+        self._check(lib.dem_vtk_write_mesh(self._d, int(mesh), os.fsencode(path)))
+
     def _render_def(self, width, height, view_axis, window, color, scalar, scalar_range, walls, background):
         r = lib.dem_default_render_def()
         r.width, r.height, r.view_axis, r.draw_walls = int(width), int(height), int(view_axis), int(bool(walls))

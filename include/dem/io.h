@@ -23,6 +23,15 @@ DEM_API dem_status dem_snapshot_write(dem_domain *domain, const char *path);
  * or DEM_ERR_FORMAT (not a libdem snapshot, missing or inconsistent data), saying what. */
 DEM_API dem_status dem_snapshot_read(const char *path, dem_domain **out, char *msg, size_t msg_size);
 
+/* VTK XML unstructured grids (.vtu, ASCII, exact) for ParaView and other tools. Particles:
+ * one vertex per sphere with point data radius, velocity, angular_velocity, force (contact
+ * force), id and material; the field TIME is the domain time. A mesh wall: its triangles at
+ * the current pose with cell data force (the force the particles exert on each triangle).
+ * Forces are brought up to date first when needed (as dem_domain_step(d, 0)). DEM_ERR_IO when
+ * the file cannot be written; DEM_ERR_UNKNOWN_WALL for a mesh index out of range. */
+DEM_API dem_status dem_vtk_write_particles(dem_domain *domain, const char *path);
+DEM_API dem_status dem_vtk_write_mesh(dem_domain *domain, int mesh, const char *path);
+
 typedef enum dem_color_mode {
     DEM_COLOR_MATERIAL = 0, /* a fixed palette by material */
     DEM_COLOR_SCALAR = 1,   /* a per-particle scalar mapped through a blue-to-red colour map */

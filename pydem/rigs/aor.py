@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
-from .common import (Stepper, frame, lattice_fill, make_domain, params_from, size_distribution, stable_dt,
+from .common import (Frames, Stepper, lattice_fill, make_domain, params_from, size_distribution, stable_dt,
                      translational_energy_per_particle)
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult, block_average
@@ -57,7 +57,8 @@ class AngleOfRepose:
     def __init__(self, config: AorConfig | None = None):
         self.config = config or AorConfig.preset("default")
 
-    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None) -> RigResult:
+    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
+            vtk_dir: str | Path | None = None) -> RigResult:
         c = self.config
         p = params_from(c.params, params)
         rng = np.random.default_rng(seed)
@@ -85,7 +86,7 @@ class AngleOfRepose:
         ke_rest = c.rest_energy * mass * 9.81 * dmean
         st = Stepper(d, progress, planned_time=c.max_time)
         frames, next_frame = [], [0.0]
-        fdir = Path(frames_dir) if frames_dir else None
+        out = Frames(frames_dir, vtk_dir)
 
         def each():
             x = d.positions
@@ -95,8 +96,8 @@ class AngleOfRepose:
                 d.remove_particles(lost)
             ke = translational_energy_per_particle(d, p.density)
             st.record(time=d.time, kinetic_energy=ke, cylinder_z=cyl.pose[0][2], particles=len(d))
-            if fdir is not None and d.time >= next_frame[0]:
-                frames.append(frame(d, fdir, f"aor_{len(frames):04d}.png", window=((-half, half), (-0.1 * half, 0.995 * half))))
+            if out.active and d.time >= next_frame[0]:
+                frames.append(out.write(d, f"aor_{len(frames):04d}.png", window=((-half, half), (-0.1 * half, 0.995 * half))))
                 next_frame[0] += c.frame_interval
             return False
 

@@ -125,10 +125,26 @@ def translational_energy_per_particle(d: Domain, density: float) -> float:
     return float(0.5 * np.sum(m * np.sum(d.velocities ** 2, axis=1)) / n)
 
 
-def frame(d: Domain, directory: Path | None, name: str, **render) -> str | None:
-    if directory is None:
-        return None
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / name
-    d.render_png(path, **render)
-    return str(path)
+class Frames:
+    """Where a rig's frames go at its frame times: PNG images (`frames_dir`) and/or a VTK time
+    series for ParaView (`vtk_dir`: particles and mesh walls, pydem.vtk)."""
+
+    def __init__(self, frames_dir: str | Path | None = None, vtk_dir: str | Path | None = None):
+        self.dir = Path(frames_dir) if frames_dir else None
+        from ..vtk import VtkSeries
+        self.vtk = VtkSeries(vtk_dir) if vtk_dir else None
+
+    @property
+    def active(self) -> bool:
+        return self.dir is not None or self.vtk is not None
+
+    def write(self, d: Domain, name: str, **render) -> str | None:
+        """The PNG's path (None without a frames directory)."""
+        if self.vtk is not None:
+            self.vtk.write(d)
+        if self.dir is None:
+            return None
+        self.dir.mkdir(parents=True, exist_ok=True)
+        path = self.dir / name
+        d.render_png(path, **render)
+        return str(path)

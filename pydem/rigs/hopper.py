@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
-from .common import Stepper, frame, make_domain, params_from, stable_dt, translational_energy_per_particle
+from .common import Frames, Stepper, make_domain, params_from, stable_dt, translational_energy_per_particle
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult
 
@@ -148,7 +148,8 @@ class Hopper:
         return (np.abs(g[:, 0]) < wall_x - margin / max(math.cos(math.radians(c.wall_angle)), 1e-3)) & (g[:, 2] > margin)
 
     # ---- the run ------------------------------------------------------------------------------
-    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None) -> RigResult:
+    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
+            vtk_dir: str | Path | None = None) -> RigResult:
         c = self.config
         p = params_from(c.params, params)
         rng = np.random.default_rng(seed)
@@ -183,7 +184,7 @@ class Hopper:
         t0 = d.time
         gate.set_motion(velocity=(0.0, 0.0, -2.0))
         frames, next_frame, last_out = [], [t0], [t0, n_initial]
-        fdir = Path(frames_dir) if frames_dir else None
+        out = Frames(frames_dir, vtk_dir)
         win = self._window(h_wedge, z_top)
 
         def each():
@@ -199,8 +200,8 @@ class Hopper:
             st.record(time=d.time - t0, remaining=n_r, remaining_mass=float(masses()[inside].sum()))
             if n_r < last_out[1]:
                 last_out[:] = [d.time, n_r]
-            if fdir is not None and d.time >= next_frame[0]:
-                frames.append((frame(d, fdir, f"frame_{len(frames):05d}.png", width=c.frame_width,
+            if out.active and d.time >= next_frame[0]:
+                frames.append((out.write(d, f"frame_{len(frames):05d}.png", width=c.frame_width,
                                      height=c.frame_height, window=win, color="grey"), d.time - t0, n_r / n_initial))
                 next_frame[0] += c.frame_interval
             return n_r == 0 or d.time - last_out[0] > c.jam_time
@@ -218,7 +219,7 @@ class Hopper:
         res.metrics["bulk_density"] = Metric(density[0], density[1], "kg/m^3", "settled bed in the vertical section")
         series["nrrp"] = nr / n_initial
         res.series = series
-        res.frames = self._label_frames(frames, t_dis, fdir)
+        res.frames = self._label_frames(frames, t_dis, out.dir)  # without PNGs (VTK only) there is nothing to label
         res.info = {"particles": n_initial, "fine": n_fine, "coarse": n_coarse, "case": c.case, "packing": c.packing,
                     "steps": st.steps, "dt": d.dt, "simulated_time": d.time, "emptied": emptied,
                     "engine_profile": d.profile(),
@@ -301,7 +302,7 @@ class Hopper:
     @staticmethod
     def _label_frames(frames, t_dis: float, fdir: Path | None) -> list[str]:
         """Renames frames to carry their labels and writes frames/index.csv."""
-        if not frames or fdir is None:
+        if fdir is None:
             return []
         out = []
         with open(fdir / "index.csv", "w", newline="") as f:

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
-from .common import Stepper, frame, lattice_fill, make_domain, params_from, size_distribution, stable_dt
+from .common import Frames, Stepper, lattice_fill, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
 from . import yield_locus as locus
 from .result import Metric, RigResult, block_average
@@ -89,7 +89,8 @@ class RingShear:
     def __init__(self, config: RingShearConfig | None = None):
         self.config = config or RingShearConfig.preset("default")
 
-    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None) -> RigResult:
+    def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
+            vtk_dir: str | Path | None = None) -> RigResult:
         c = self.config
         if not c.outer_radius > c.inner_radius + 4 * c.diameter:
             raise ValueError("outer_radius must exceed inner_radius by at least 4 diameters")
@@ -132,7 +133,7 @@ class RingShear:
         lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
         lid.reset_mean_force()
         omega = c.shear_speed / rm
-        frames, fdir, next_frame = [], Path(frames_dir) if frames_dir else None, [0.0]
+        frames, out, next_frame = [], Frames(frames_dir, vtk_dir), [0.0]
         phase_log = []
 
         def lid_state():
@@ -149,8 +150,8 @@ class RingShear:
                 s, tau = lid_state()
                 z_lid = lid.pose[0][2] + v[0, 2]
                 st.record(time=d.time, sigma=s, tau=tau, lid_z=z_lid, phase=tag)
-                if fdir is not None and d.time >= next_frame[0]:
-                    frames.append(frame(d, fdir, f"ring_{len(frames):04d}.png", width=420, height=230,
+                if out.active and d.time >= next_frame[0]:
+                    frames.append(out.write(d, f"ring_{len(frames):04d}.png", width=420, height=230,
                                         window=((-ro * 1.05, ro * 1.05), (-0.1 * height, -0.1 * height + 2.1 * ro * 230 / 420))))
                     next_frame[0] += c.frame_interval
                 return False
