@@ -91,20 +91,62 @@ class RingShear:
 
     def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
             vtk_dir: str | Path | None = None) -> RigResult:
+        """The Schulze procedure, phase by phase (module docstring); the metrics from the
+        measured lid stresses by the pure functions below."""
         c = self.config
+        t = Tester(c, params_from(c.params, params), seed, Frames(frames_dir, vtk_dir), progress, self._planned_time())
+        t.load_to(c.preshear_stress, 1.0)
+        steady = [t.preshear(c.first_preshear_displacement)]
+        points = []
+        for frac in [f for f in c.shear_points for _ in range(c.shear_repeats)]:
+            steady.append(t.preshear(c.preshear_displacement))
+            t.load_to(frac * c.preshear_stress)
+            tau_sh, sigma_sh = t.shear_to_failure()
+            points.append((frac, sigma_sh, tau_sh))
+            t.load_to(c.preshear_stress)
+        res = RigResult("ring-shear")
+        tau_pre, sigma_pre, z_lid = preshear_metrics(steady, res.metrics)
+        shear_point_metrics(points, res.metrics)
+        locus_metrics(sigma_pre, tau_pre, points, res.metrics, res.info)
+        d = t.d
+        mass = float(np.sum(t.p.density * 4 / 3 * math.pi * d.radii ** 3))
+        res.metrics["bulk_density"] = Metric(mass / (t.area * z_lid), math.nan, "kg/m^3", "mass / (lid area x lid height)")
+        gamma_dot = c.shear_speed / z_lid
+        res.metrics["inertial_number"] = Metric(gamma_dot * c.diameter / math.sqrt(sigma_pre / t.p.density), math.nan, "",
+                                                "shear rate = speed at R_mean / bed height")
+        res.series = {k: np.asarray(v) for k, v in t.st.series.items()}
+        res.frames = [f for f in t.frames if f]
+        res.info.update({"particles": c.particles, "steps": t.st.steps, "dt": d.dt, "simulated_time": d.time,
+                         "engine_profile": d.profile(), "wall_seconds": t.st.wall_seconds(), "seed": seed,
+                         "phases": t.phase_log,
+                         "shear_points": [{"fraction": f, "sigma": s, "tau_peak": tp} for f, s, tp in points]})
+        return res
+
+    def _planned_time(self) -> float:
+        c = self.config
+        cycles = len(c.shear_points) * c.shear_repeats
+        shear = c.first_preshear_displacement + cycles * (c.preshear_displacement + c.shear_displacement)
+        return 0.25 + 0.2 + shear / c.shear_speed + 0.1 * cycles
+
+
+class Tester:
+    """The rig in one state: the filled, settled trough under its lid, and the phases of the
+    procedure as methods (each samples the lid stresses into the stepper's series)."""
+
+    def __init__(self, c: RingShearConfig, p: Params, seed: int, out: Frames, progress, planned_time: float):
         if not c.outer_radius > c.inner_radius + 4 * c.diameter:
             raise ValueError("outer_radius must exceed inner_radius by at least 4 diameters")
-        p = params_from(c.params, params)
+        self.c, self.p, self.out = c, p, out
         rng = np.random.default_rng(seed)
         ri, ro, dm = c.inner_radius, c.outer_radius, c.diameter
-        rm = 0.5 * (ri + ro)
-        area = math.pi * (ro ** 2 - ri ** 2)
-        moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
+        self.area = math.pi * (ro ** 2 - ri ** 2)
+        self.moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
+        self.omega = c.shear_speed / (0.5 * (ri + ro))
         radii = size_distribution(rng, c.particles, dm, c.size_spread)
         spacing = 1.05 * 2 * radii.max()
         ring = math.pi * ((ro - 0.55 * spacing) ** 2 - (ri + 0.55 * spacing) ** 2) / spacing ** 2
         fill_top = spacing * (c.particles / max(ring * 0.7, 1.0) + 2) + c.bar_height
-        height = fill_top + 3 * c.bar_height + 4 * dm
+        self.height = height = fill_top + 3 * c.bar_height + 4 * dm
         lo, hi = (-ro - 2 * dm, -ro - 2 * dm, -2 * dm), (ro + 2 * dm, ro + 2 * dm, height)
         # Spheres dragged along the turning side walls jam against the held lid's bars; at E = 5 MPa
         # such a jam reaches 0.3-0.6 of a radius before it releases (a third of the runs of a tiny-
@@ -112,7 +154,8 @@ class RingShear:
         # spheres (E = 2e7 passes) avoid the jams at 1.7x the cost.
         d, mp, mw = make_domain(lo, hi, p, c.num_threads, diameter=dm, max_overlap_ratio=c.max_overlap_ratio)
         d.seed = seed
-        trough = d.add_mesh_wall(geometry.merge(
+        self.d = d
+        self.trough = d.add_mesh_wall(geometry.merge(
             geometry.annulus(ri, ro, 0.0, segments=72, rings=2),
             geometry.cylinder(ri, 0.0, height, segments=72), geometry.cylinder(ro, 0.0, height, segments=72),
             geometry.radial_bars(ri, ro, 0.0, c.bar_height, c.bars, 0.1 * dm)), material=mw)
@@ -121,8 +164,8 @@ class RingShear:
                            & (np.hypot(g[:, 0], g[:, 1]) < ro - 0.55 * spacing), count=c.particles, jitter=0.02)
         d.add_particles(pos, radii, mp)
         d.dt = stable_dt(d, impact_speed=0.3)  # slow shearing: enduring contacts, gentle impacts
-        st = Stepper(d, progress, planned_time=self._planned_time())
-        st.advance(0.25)  # settle
+        self.st = Stepper(d, progress, planned_time=planned_time)
+        self.st.advance(0.25)  # settle
         top = float((d.positions[:, 2] + d.radii).max())
         gap = 0.3e-3
         lid_mesh = geometry.merge(geometry.annulus(ri + gap, ro - gap, 0.0, segments=72, rings=2),
@@ -130,149 +173,140 @@ class RingShear:
                                                        phase=math.pi / max(c.bars, 1)))
         v = lid_mesh[0].copy()
         v[:, 2] += top + dm + max(0.0, c.bar_height - 0.8 * dm)  # bar tips start above the bed
-        lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
-        lid.reset_mean_force()
-        omega = c.shear_speed / rm
-        frames, out, next_frame = [], Frames(frames_dir, vtk_dir), [0.0]
-        phase_log = []
+        self.lid_z0 = v[0, 2]
+        self.lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
+        self.lid.reset_mean_force()
+        self.frames, self.next_frame, self.phase_log = [], 0.0, []
 
-        def lid_state():
-            """Lid stresses averaged over the steps since the previous sample (a snapshot rattles
-            by tens of per cent from step to step)."""
-            f, t, seconds = lid.mean_force((0.0, 0.0, 0.0))
-            if seconds == 0.0:
-                f, t = lid.force((0.0, 0.0, 0.0))
-            lid.reset_mean_force()
-            return f[2] / area, t[2] / moment  # sigma: particles push the lid up; tau: they drag it along +omega
+    def lid_state(self) -> tuple[float, float]:
+        """Lid stresses averaged over the steps since the previous sample (a snapshot rattles
+        by tens of per cent from step to step)."""
+        f, t, seconds = self.lid.mean_force((0.0, 0.0, 0.0))
+        if seconds == 0.0:
+            f, t = self.lid.force((0.0, 0.0, 0.0))
+        self.lid.reset_mean_force()
+        return f[2] / self.area, t[2] / self.moment  # sigma: particles push the lid up; tau: they drag it along +omega
 
-        def sample(tag):
-            def each():
-                s, tau = lid_state()
-                z_lid = lid.pose[0][2] + v[0, 2]
-                st.record(time=d.time, sigma=s, tau=tau, lid_z=z_lid, phase=tag)
-                if out.active and d.time >= next_frame[0]:
-                    frames.append(out.write(d, f"ring_{len(frames):04d}.png", width=420, height=230,
-                                        window=((-ro * 1.05, ro * 1.05), (-0.1 * height, -0.1 * height + 2.1 * ro * 230 / 420))))
-                    next_frame[0] += c.frame_interval
-                return False
-            return each
+    def sample(self, tag: str):
+        """A stepper callback that records sigma, tau and the lid height (and frames when due)."""
+        def each():
+            s, tau = self.lid_state()
+            self.st.record(time=self.d.time, sigma=s, tau=tau, lid_z=self.lid.pose[0][2] + self.lid_z0, phase=tag)
+            if self.out.active and self.d.time >= self.next_frame:
+                ro, h = self.c.outer_radius, self.height
+                self.frames.append(self.out.write(self.d, f"ring_{len(self.frames):04d}.png", width=420, height=230,
+                                                  window=((-ro * 1.05, ro * 1.05), (-0.1 * h, -0.1 * h + 2.1 * ro * 230 / 420))))
+                self.next_frame += self.c.frame_interval
+            return False
+        return each
 
-        def load_to(sigma, max_seconds=0.5):
-            """Servo to sigma and wait until the lid holds it (5 samples within 3 %)."""
-            lid.set_servo(direction=(0, 0, -1), target_stress=sigma, area=area, max_speed=c.servo_speed,
-                          proportional_band=0.3, filter_time=2e-3)
-            record = sample("load")
+    def load_to(self, sigma: float, max_seconds: float = 0.5):
+        """Servo to sigma and wait until the lid holds it (5 samples within 3 %)."""
+        self.lid.set_servo(direction=(0, 0, -1), target_stress=sigma, area=self.area, max_speed=self.c.servo_speed,
+                           proportional_band=0.3, filter_time=2e-3)
+        record = self.sample("load")
 
-            def settled():
-                record()
-                last = st.series["sigma"][-5:]
-                return len(last) == 5 and all(abs(x - sigma) < 0.03 * sigma for x in last)
+        def settled():
+            record()
+            last = self.st.series["sigma"][-5:]
+            return len(last) == 5 and all(abs(x - sigma) < 0.03 * sigma for x in last)
 
-            st.advance(max_seconds, chunk=2e-3, each=settled)
+        self.st.advance(max_seconds, chunk=2e-3, each=settled)
 
-        def preshear(displacement):
-            """Shears at sigma_pre until steady (or max_preshear); returns the tau, sigma and lid
-            height samples of the steady part (its second half)."""
-            trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
-            start = len(st.series.get("tau", []))
-            chunk = min(0.05 * displacement / c.shear_speed, 0.01)  # >= 20 samples: quarters of 5+
-            st.advance(displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
-            total = displacement
-            while True:
-                taus = np.array(st.series["tau"][start:])
-                q = len(taus) // 4
-                if q >= 2:
-                    a, b = taus[-2 * q:-q].mean(), taus[-q:].mean()
-                    if abs(b - a) <= c.steady_tolerance * abs(b) or total >= c.max_preshear:
-                        break
-                st.advance(0.25 * displacement / c.shear_speed, chunk=chunk, each=sample("preshear"))
-                total += 0.25 * displacement
-            trough.set_motion((0, 0, 0))
-            half = start + (len(st.series["tau"]) - start) // 2
-            phase_log.append(("preshear", total))
-            return tuple(np.array(st.series[k][half:]) for k in ("tau", "sigma", "lid_z"))
-
-        def shear_to_failure():
-            trough.set_motion((0, 0, 0), (0, 0, omega), (0, 0, 0))
-            start = len(st.series["tau"])
-            peak = [-math.inf, 0.0]
-
-            def each():
-                sample("shear")()
-                tau = st.series["tau"][-1]
-                moved = (d.time - t_start) * c.shear_speed
-                if tau > peak[0]:
-                    peak[:] = [tau, st.series["sigma"][-1]]
-                return moved > 0.3 * dm and tau < 0.9 * peak[0]  # past the peak: failed
-
-            t_start = d.time
-            st.advance(c.shear_displacement / c.shear_speed, chunk=0.1 * dm / c.shear_speed, each=each)
-            trough.set_motion((0, 0, 0))
+    def preshear(self, displacement: float):
+        """Shears at sigma_pre until steady (or max_preshear); returns the tau, sigma and lid
+        height samples of the steady part (its second half)."""
+        c, st = self.c, self.st
+        self.trough.set_motion((0, 0, 0), (0, 0, self.omega), (0, 0, 0))
+        start = len(st.series.get("tau", []))
+        chunk = min(0.05 * displacement / c.shear_speed, 0.01)  # >= 20 samples: quarters of 5+
+        st.advance(displacement / c.shear_speed, chunk=chunk, each=self.sample("preshear"))
+        total = displacement
+        while True:
             taus = np.array(st.series["tau"][start:])
-            phase_log.append(("shear", (d.time - t_start) * c.shear_speed))
-            return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
+            q = len(taus) // 4
+            if q >= 2:
+                a, b = taus[-2 * q:-q].mean(), taus[-q:].mean()
+                if abs(b - a) <= c.steady_tolerance * abs(b) or total >= c.max_preshear:
+                    break
+            st.advance(0.25 * displacement / c.shear_speed, chunk=chunk, each=self.sample("preshear"))
+            total += 0.25 * displacement
+        self.trough.set_motion((0, 0, 0))
+        half = start + (len(st.series["tau"]) - start) // 2
+        self.phase_log.append(("preshear", total))
+        return tuple(np.array(st.series[k][half:]) for k in ("tau", "sigma", "lid_z"))
 
-        load_to(c.preshear_stress, 1.0)
-        steady = [preshear(c.first_preshear_displacement)]
-        mass = float(np.sum(p.density * 4 / 3 * math.pi * d.radii ** 3))
-        res = RigResult("ring-shear")
-        points = []
-        for frac in [f for f in c.shear_points for _ in range(c.shear_repeats)]:
-            steady.append(preshear(c.preshear_displacement))
-            load_to(frac * c.preshear_stress)
-            tau_sh, sigma_sh = shear_to_failure()
-            points.append((frac, sigma_sh, tau_sh))
-            load_to(c.preshear_stress)
-        # every pre-shear ends in the same steady flow: tau_pre, sigma_pre and the density are
-        # means over the steady parts of all of them (as a Schulze tester's operator averages)
-        tau_steady, sig_steady, z_steady = (np.concatenate([part[k] for part in steady]) for k in range(3))
-        tau_pre, tau_pre_se = block_average(tau_steady, 4)
-        sigma_pre = float(np.mean(sig_steady))
-        z_lid = float(np.mean(z_steady))
-        res.metrics["tau_preshear"] = Metric(tau_pre, tau_pre_se, "Pa", "steady halves of all pre-shears")
-        res.metrics["sigma_preshear"] = Metric(sigma_pre, float(np.std(sig_steady) / math.sqrt(4)), "Pa", "lid")
-        res.metrics["mu_ie_ps"] = Metric(tau_pre / sigma_pre, tau_pre_se / sigma_pre, "", "tau_pre / sigma_pre")
-        for frac in dict.fromkeys(f for f, _, _ in points):  # distinct fractions, in order
-            rep = np.array([(s, t) for f, s, t in points if f == frac])
-            mu, mu_se = mean_and_se(rep[:, 1] / rep[:, 0])
-            tau, tau_se = mean_and_se(rep[:, 1])
-            tag, what = int(round(frac * 100)), f"at {frac:.0%}" + (f", mean of {len(rep)} repeats" if len(rep) > 1 else "")
-            res.metrics[f"mu_ie_s_{tag}"] = Metric(mu, mu_se, "", f"peak tau / sigma {what}")
-            res.metrics[f"tau_shear_{tag}"] = Metric(tau, tau_se, "Pa", f"sigma_sh = {rep[:, 0].mean():.0f} Pa, {what}")
-        if len({f for f, _, _ in points}) >= 2:
-            slope, icpt = yield_locus([q[1] for q in points], [q[2] for q in points])
-            res.metrics["yield_locus_slope"] = Metric(*slope, "", "least squares through the shear points")
-            res.metrics["yield_locus_intercept"] = Metric(*icpt, "Pa", "cohesion estimate")
-            try:  # the outputs a Schulze tester reports (yield_locus.py)
-                loc = locus.evaluate(sigma_pre, tau_pre, [q[1] for q in points], [q[2] for q in points])
-            except ValueError as exc:
-                res.info["yield_locus_note"] = str(exc)
-            else:
-                for key, value, unit, note in (
-                        ("phi_lin", loc.phi_lin, "deg", "linearised angle of internal friction"),
-                        ("phi_e", loc.phi_e, "deg", "effective angle of internal friction"),
-                        ("phi_sf", loc.phi_sf, "deg", "steady-state flow angle"),
-                        ("sigma_1", loc.sigma_1, "Pa", "major consolidation stress"),
-                        ("sigma_c", loc.sigma_c, "Pa", "unconfined yield strength"),
-                        ("ffc", loc.ffc, "", "flow function sigma_1 / sigma_c")):
-                    res.metrics[key] = Metric(value, math.nan, unit, note)
-        res.metrics["bulk_density"] = Metric(mass / (area * z_lid), math.nan, "kg/m^3", "mass / (lid area x lid height)")
-        gamma_dot = c.shear_speed / z_lid
-        res.metrics["inertial_number"] = Metric(gamma_dot * dm / math.sqrt(sigma_pre / p.density), math.nan, "",
-                                                "shear rate = speed at R_mean / bed height")
-        res.series = {k: np.asarray(v) for k, v in st.series.items()}
-        res.frames = [f for f in frames if f]
-        res.info = {"particles": c.particles, "steps": st.steps, "dt": d.dt, "simulated_time": d.time,
-                    "engine_profile": d.profile(),
-                    "wall_seconds": st.wall_seconds(), "seed": seed, "phases": phase_log,
-                    "shear_points": [{"fraction": f, "sigma": s, "tau_peak": t} for f, s, t in points]}
-        return res
+    def shear_to_failure(self) -> tuple[float, float]:
+        """Shears at the current load until tau falls below 90 % of its peak (after 0.3 d):
+        (peak tau, sigma at the peak)."""
+        c, st, d = self.c, self.st, self.d
+        self.trough.set_motion((0, 0, 0), (0, 0, self.omega), (0, 0, 0))
+        start = len(st.series["tau"])
+        peak = -math.inf
+        record = self.sample("shear")
+        t_start = d.time
 
-    def _planned_time(self) -> float:
-        c = self.config
-        cycles = len(c.shear_points) * c.shear_repeats
-        shear = c.first_preshear_displacement + cycles * (c.preshear_displacement + c.shear_displacement)
-        return 0.25 + 0.2 + shear / c.shear_speed + 0.1 * cycles
+        def each():
+            nonlocal peak
+            record()
+            tau = st.series["tau"][-1]
+            peak = max(peak, tau)
+            return (d.time - t_start) * c.shear_speed > 0.3 * c.diameter and tau < 0.9 * peak  # past the peak: failed
+
+        st.advance(c.shear_displacement / c.shear_speed, chunk=0.1 * c.diameter / c.shear_speed, each=each)
+        self.trough.set_motion((0, 0, 0))
+        taus = np.array(st.series["tau"][start:])
+        self.phase_log.append(("shear", (d.time - t_start) * c.shear_speed))
+        return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
+
+
+def preshear_metrics(steady: list[tuple[np.ndarray, np.ndarray, np.ndarray]], metrics: dict) -> tuple[float, float, float]:
+    """tau_pre, sigma_pre and mu_ie-ps from the steady parts (tau, sigma, lid height samples) of
+    every pre-shear: each ends in the same steady flow, so they are means over all of them (as a
+    Schulze tester's operator averages). Returns (tau_pre, sigma_pre, mean lid height)."""
+    tau_steady, sig_steady, z_steady = (np.concatenate([part[k] for part in steady]) for k in range(3))
+    tau_pre, tau_pre_se = block_average(tau_steady, 4)
+    sigma_pre = float(np.mean(sig_steady))
+    metrics["tau_preshear"] = Metric(tau_pre, tau_pre_se, "Pa", "steady halves of all pre-shears")
+    metrics["sigma_preshear"] = Metric(sigma_pre, float(np.std(sig_steady) / math.sqrt(4)), "Pa", "lid")
+    metrics["mu_ie_ps"] = Metric(tau_pre / sigma_pre, tau_pre_se / sigma_pre, "", "tau_pre / sigma_pre")
+    return tau_pre, sigma_pre, float(np.mean(z_steady))
+
+
+def shear_point_metrics(points: list[tuple[float, float, float]], metrics: dict):
+    """mu_ie-s and tau_sh per shear fraction from (fraction, sigma_sh, tau_sh) points: the mean
+    of the repeats with its standard error."""
+    for frac in dict.fromkeys(f for f, _, _ in points):  # distinct fractions, in order
+        rep = np.array([(s, t) for f, s, t in points if f == frac])
+        mu, mu_se = mean_and_se(rep[:, 1] / rep[:, 0])
+        tau, tau_se = mean_and_se(rep[:, 1])
+        tag, what = int(round(frac * 100)), f"at {frac:.0%}" + (f", mean of {len(rep)} repeats" if len(rep) > 1 else "")
+        metrics[f"mu_ie_s_{tag}"] = Metric(mu, mu_se, "", f"peak tau / sigma {what}")
+        metrics[f"tau_shear_{tag}"] = Metric(tau, tau_se, "Pa", f"sigma_sh = {rep[:, 0].mean():.0f} Pa, {what}")
+
+
+def locus_metrics(sigma_pre: float, tau_pre: float, points, metrics: dict, info: dict):
+    """The yield locus through the shear points (two fractions at least) and the outputs a
+    Schulze tester reports (yield_locus.py); a locus they cannot be read from is noted in info."""
+    if len({f for f, _, _ in points}) < 2:
+        return
+    sig, tau = [q[1] for q in points], [q[2] for q in points]
+    slope, icpt = yield_locus(sig, tau)
+    metrics["yield_locus_slope"] = Metric(*slope, "", "least squares through the shear points")
+    metrics["yield_locus_intercept"] = Metric(*icpt, "Pa", "cohesion estimate")
+    try:
+        loc = locus.evaluate(sigma_pre, tau_pre, sig, tau)
+    except ValueError as exc:
+        info["yield_locus_note"] = str(exc)
+        return
+    for key, value, unit, note in (
+            ("phi_lin", loc.phi_lin, "deg", "linearised angle of internal friction"),
+            ("phi_e", loc.phi_e, "deg", "effective angle of internal friction"),
+            ("phi_sf", loc.phi_sf, "deg", "steady-state flow angle"),
+            ("sigma_1", loc.sigma_1, "Pa", "major consolidation stress"),
+            ("sigma_c", loc.sigma_c, "Pa", "unconfined yield strength"),
+            ("ffc", loc.ffc, "", "flow function sigma_1 / sigma_c")):
+        metrics[key] = Metric(value, math.nan, unit, note)
 
 
 def mean_and_se(x) -> tuple[float, float]:

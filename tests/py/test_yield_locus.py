@@ -9,6 +9,7 @@ sigma_1 = p + r = 4933.01 Pa; ffc = 4933.01 / 1732.05 = 2.84809;
 phi_e = asin(r / p) = asin(0.644338) = 40.116 deg; phi_sf = atan(1654.26 / 2000) = 39.595 deg."""
 import math
 
+import numpy as np
 import pytest
 
 from pydem.rigs.yield_locus import evaluate
@@ -43,3 +44,34 @@ def test_cohesionless_locus_and_bad_input():
         evaluate(2000.0, 900.0, [1000.0, 1000.0], [500.0, 510.0])
     with pytest.raises(ValueError, match="above the yield locus"):
         evaluate(2000.0, 5000.0, [500.0, 1000.0], [250.0, 500.0])
+
+
+def test_ring_shear_metric_functions_by_hand():
+    """The ring shear's pure metric functions on hand-made lid samples and shear points."""
+    import math
+    from pydem.rigs.ring_shear import locus_metrics, preshear_metrics, shear_point_metrics
+    m, info = {}, {}
+    steady = [(np.full(8, 1000.0), np.full(8, 2000.0), np.full(8, 0.02)),
+              (np.full(4, 1100.0), np.full(4, 2000.0), np.full(4, 0.03))]
+    tau_pre, sigma_pre, z = preshear_metrics(steady, m)
+    assert tau_pre == pytest.approx(12400 / 12, rel=1e-14) and sigma_pre == 2000.0
+    assert z == pytest.approx((8 * 0.02 + 4 * 0.03) / 12, rel=1e-14)
+    assert m["mu_ie_ps"].value == pytest.approx(tau_pre / 2000.0, rel=1e-14)
+    points = [(0.4, 800.0, 500.0), (0.4, 820.0, 520.0), (0.8, 1600.0, 900.0)]
+    shear_point_metrics(points, m)
+    mus = [500 / 800, 520 / 820]
+    assert m["mu_ie_s_40"].value == pytest.approx(np.mean(mus), rel=1e-14)
+    assert m["mu_ie_s_40"].uncertainty == pytest.approx(np.std(mus, ddof=1) / math.sqrt(2), rel=1e-12)
+    assert m["mu_ie_s_80"].value == 900 / 1600 and math.isnan(m["mu_ie_s_80"].uncertainty)
+    line = [(0.25, 500.0, 100 + 0.5 * 500), (0.5, 1000.0, 100 + 0.5 * 1000), (0.75, 1500.0, 100 + 0.5 * 1500)]
+    locus_metrics(2000.0, 100 + 0.5 * 2000 + 50, line, m, info)  # a pre-shear point above the locus: noted
+    assert "above the yield locus" in info["yield_locus_note"] and "phi_lin" not in m
+    info.clear()
+    locus_metrics(2000.0, 100 + 0.5 * 2000, line, m, info)  # on its end, as in steady flow
+    assert m["yield_locus_slope"].value == pytest.approx(0.5, rel=1e-12)
+    assert m["yield_locus_intercept"].value == pytest.approx(100.0, rel=1e-10)
+    assert not info and m["phi_lin"].value == pytest.approx(math.degrees(math.atan(0.5)), rel=1e-12)
+    assert m["ffc"].value > 1
+    one = {}
+    locus_metrics(2000.0, 1000.0, [(0.5, 1000.0, 600.0)], one, {})
+    assert one == {}  # one fraction: no locus
