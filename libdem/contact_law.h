@@ -173,21 +173,27 @@ DEM_INLINE void contact_law(const pair_props *pp, const contact_in *c, double dt
         }
     }
 
-    /* optional effects add to the normal force (cohesion pulls: negative) */
+    /* optional effects add to the normal force (cohesion pulls: negative) and to the torque */
     double fn_total = fn;
     if (pp->n_effects > 0) {
         dem_effect_contact ec;
-        ec.n[0] = n[0];
-        ec.n[1] = n[1];
-        ec.n[2] = n[2];
+        for (int a = 0; a < 3; a++) {
+            ec.n[a] = n[a];
+            ec.wrel[a] = c->wrel[a];
+        }
         ec.overlap = delta;
         ec.distance = c->distance;
         ec.radius_i = c->radius_i;
         ec.radius_j = c->radius_j;
         ec.normal_force = fn;
+        ec.r_eff = c->r_eff;
+        ec.inv_inertia = 2.5 * c->inv_mass_i / (c->radius_i * c->radius_i)
+                         + (c->radius_j > 0.0 ? 2.5 * c->inv_mass_j / (c->radius_j * c->radius_j) : 0.0);
+        ec.tangential_stiffness = kt;
         for (int k = 0; k < pp->n_effects; k++) {
             const dem_effect_desc *ed = dem_effect_get(pp->effects[k].effect);
-            fn_total += ed->normal_force(&ec, pp->effects[k].params);
+            if (ed->normal_force) fn_total += ed->normal_force(&ec, pp->effects[k].params);
+            if (ed->torque) ed->torque(&ec, pp->effects[k].params, out->mr);
         }
     }
 

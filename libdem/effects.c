@@ -5,9 +5,11 @@
 #include <string.h>
 
 extern const dem_effect_desc dem_effect_cohesion_sjkr;
+extern const dem_effect_desc dem_effect_twisting_resistance;
 
 static const dem_effect_desc *const registry[] = {
     &dem_effect_cohesion_sjkr,
+    &dem_effect_twisting_resistance,
 };
 
 #define N_EFFECTS ((int)(sizeof registry / sizeof registry[0]))

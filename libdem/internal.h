@@ -267,6 +267,10 @@ typedef struct dem_effect_contact {
     double distance;    /* m, centre distance (pair) or centre-to-plane distance (wall) */
     double radius_i, radius_j; /* radius_j = 0 for a wall */
     double normal_force;/* N, repulsive elastic + damping part already computed (>= 0) */
+    double r_eff;       /* m, R* (the radius for a wall) */
+    double wrel[3];     /* rad/s, angular velocity of i minus the partner's */
+    double inv_inertia; /* 1/I_i + 1/I_j, 1/(kg m^2) (a wall: 1/I_i); spheres: I = 2/5 m r^2 */
+    double tangential_stiffness; /* N/m, the Mindlin k_t = 8 G* sqrt(R* overlap) */
 } dem_effect_contact;
 typedef struct dem_effect_param {
     const char *name, *unit;
@@ -276,8 +280,10 @@ typedef struct dem_effect_desc {
     const char *name, *summary;
     int n_params;
     dem_effect_param params[DEM_MAX_EFFECT_PARAMS];
-    /* returns the extra normal force (N, positive = repulsive) */
+    /* optional: returns the extra normal force (N, positive = repulsive) */
     double (*normal_force)(const dem_effect_contact *c, const double *params);
+    /* optional: adds a torque on i to torque[3] (the partner gets the opposite) */
+    void (*torque)(const dem_effect_contact *c, const double *params, double torque[3]);
 } dem_effect_desc;
 const dem_effect_desc *dem_effect_get(int index);
 int dem_effect_find(const char *name);

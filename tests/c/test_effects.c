@@ -1,6 +1,10 @@
-/* The effect registry and its first member, SJKR cohesion: F = -k_c A added to the Hertz
- * normal force, A = pi a^2 the lens circle of two spheres, pi (R^2 - r^2) against a wall.
- * Static configurations, so the expected force is plain arithmetic: tolerance 1e-12. */
+/* The effect registry and its members against closed forms.
+ * SJKR cohesion: F = -k_c A added to the Hertz normal force, A = pi a^2 the lens circle of two
+ * spheres, pi (R^2 - r^2) against a wall. Static configurations, so the expected force is plain
+ * arithmetic: tolerance 1e-12.
+ * Twisting resistance: a sphere resting on a plane and spinning about the vertical slows at the
+ * constant torque mu_t R m g (w = w0 - (5/2) mu_t g t / R) until the viscous branch of the law
+ * takes over, then creeps to rest exponentially without turning back. */
 #include "test_util.h"
 
 static const double R = 1e-3, E = 1e7, NU = 0.25, KC = 5e4;
@@ -100,12 +104,85 @@ static void test_sjkr_wall_and_switch_off(void **st)
     dem_domain_destroy(d);
 }
 
+/* A sphere of radius TR inserted at its static Hertz overlap on the floor, spinning at W0
+ * about z, with twisting friction mu_t; steps to time t_end, returns w_z(t_half) and w_z(t_end)
+ * and the smallest w_z seen (a reversal would make it negative). */
+static const double TR = 0.01, TE = 1e7, TNU = 0.25, TRHO = 2500.0, G = 9.81, W0 = 20.0;
+
+static void spin_down(double mu_t, double t_half, double t_end, double *w_half, double *w_end, double *w_min)
+{
+    dem_domain_def def = dem_default_domain_def();
+    for (int a = 0; a < 3; a++) {
+        def.lo[a] = 0.0;
+        def.hi[a] = 0.1;
+        def.gravity[a] = 0.0;
+    }
+    def.gravity[2] = -G;
+    def.dt = 1e-5; /* Rayleigh time 8.6e-4 s, Hertz contact time ~2e-3 s */
+    def.insert_overlap_ratio = 0.5;
+    dem_domain *d;
+    assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
+    dem_material_def m = dem_default_material_def();
+    m.youngs_modulus = TE;
+    m.poisson_ratio = TNU;
+    m.density = TRHO;
+    int mat, wall;
+    assert_ok(dem_material_create(d, &m, &mat));
+    dem_pair_def p = dem_default_pair_def();
+    p.rolling_friction = 0.0;
+    assert_ok(dem_pair_set(d, mat, mat, &p));
+    if (mu_t > 0) assert_ok(dem_pair_set_effect(d, mat, mat, "twisting_resistance", &mu_t, 1));
+    dem_plane_wall_def pw = dem_default_plane_wall_def();
+    pw.material = mat;
+    assert_ok(dem_plane_wall_add(d, &pw, &wall));
+    const double mass = TRHO * 4.0 / 3.0 * M_PI * TR * TR * TR;
+    const double delta = pow(mass * G / (4.0 / 3.0 * e_star_same(TE, TNU) * sqrt(TR)), 2.0 / 3.0); /* at rest */
+    double pos[3] = {0.05, 0.05, TR - delta}, r = TR, w[3] = {0.0, 0.0, W0}, om[3];
+    assert_ok(dem_particles_add(d, 1, pos, &r, &mat, NULL, w, NULL));
+    *w_min = W0;
+    const int64_t n_half = (int64_t)llround(t_half / def.dt), n_end = (int64_t)llround(t_end / def.dt);
+    for (int64_t s = 1; s <= n_end; s++) {
+        assert_ok(dem_domain_step(d, 1));
+        assert_ok(dem_particles_get_angular_velocities(d, om));
+        if (om[2] < *w_min) *w_min = om[2];
+        if (s == n_half) *w_half = om[2];
+    }
+    *w_end = om[2];
+    dem_domain_destroy(d);
+}
+
+static void test_twisting_spin_down(void **st)
+{
+    (void)st;
+    /* the closed form: Coulomb at the cap mu_t R m g down to w* = cap / c_t, then the viscous
+     * branch c_t w alone: w = w* exp(-(t - t*) / tau), tau = I / c_t */
+    const double mu_t = 0.3, mass = TRHO * 4.0 / 3.0 * M_PI * TR * TR * TR, inertia = 0.4 * mass * TR * TR;
+    const double delta = pow(mass * G / (4.0 / 3.0 * e_star_same(TE, TNU) * sqrt(TR)), 2.0 / 3.0);
+    const double g_star = TE / (4.0 * (2.0 - TNU) * (1.0 + TNU));
+    const double k_tw = (2.0 / 3.0) * 8.0 * g_star * sqrt(TR * delta) * TR * delta, c_t = 2.0 * sqrt(k_tw * inertia);
+    const double cap = mu_t * TR * mass * G, alpha = cap / inertia, w_star = cap / c_t, tau = inertia / c_t;
+    const double t_star = (W0 - w_star) / alpha; /* 21.6 ms here; tau = 11 ms */
+    const double t_half = llround(0.5 * t_star / 1e-5) * 1e-5, t_end = llround((t_star + 2.0 * tau) / 1e-5) * 1e-5;
+    double w_half, w_end, w_min;
+    spin_down(mu_t, t_half, t_end, &w_half, &w_end, &w_min);
+    /* Coulomb phase: the normal force is m g (a static start), the torque constant; 1e-5 is
+     * round-off plus the first step's half-kick */
+    assert_close(w_half, W0 - alpha * t_half, 1e-5, 0);
+    /* viscous phase: explicit integration of the decay, dt / tau = 1e-3: within 2e-3 */
+    assert_close(w_end, w_star * exp(-(t_end - t_star) / tau), 2e-3, 0);
+    assert_true(w_min > 0.0); /* it creeps to rest, never turns back */
+    /* neutral value: no twisting torque at all, the spin stays W0 to round-off */
+    spin_down(0.0, t_half, t_end, &w_half, &w_end, &w_min);
+    assert_close(w_end, W0, 1e-12, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_registry),
         cmocka_unit_test(test_sjkr_pair),
         cmocka_unit_test(test_sjkr_wall_and_switch_off),
+        cmocka_unit_test(test_twisting_spin_down),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
