@@ -57,23 +57,42 @@ def effects() -> list[dict]:
     return out
 
 
-class Domain:
-    """A simulation box with materials, particles and walls. SI units throughout."""
+def c_definition(maker, ctype: str, **given):
+    """A libdem definition struct: the library's defaults (its dem_default_*_def maker: libdem
+    owns every default), then the values given; None keeps the default."""
+    s = ffi.new(ctype, maker())
+    for key, value in given.items():
+        if value is None:
+            continue
+        field = getattr(s, key)
+        if isinstance(field, ffi.CData):  # a fixed array (lo, hi, gravity, ...)
+            for a, x in enumerate(value):
+                field[a] = x
+        else:
+            setattr(s, key, value)
+    return s
 
-    def __init__(self, lo: Sequence[float] = (0.0, 0.0, 0.0), hi: Sequence[float] = (0.1, 0.1, 0.1),
-                 periodic: Sequence[bool] = (False, False, False), gravity: Sequence[float] = (0.0, 0.0, -9.81),
-                 dt: float = 1e-5, skin: float = 2e-4, num_threads: int = 1, max_overlap_ratio: float = 0.3,
-                 insert_overlap_ratio: float = 1e-3, reference_velocity: float = 1.0, _ptr=None):
+
+class Domain:
+    """A simulation box with materials, particles and walls. SI units throughout. Arguments left
+    at None take libdem's defaults (dem_default_domain_def: a 0.1 m box from the origin, gravity
+    -9.81 m/s^2 along z, dt 1e-5 s, skin 2e-4 m, 1 thread, ...; `settings` shows them)."""
+
+    def __init__(self, lo: Sequence[float] | None = None, hi: Sequence[float] | None = None,
+                 periodic: Sequence[bool] | None = None, gravity: Sequence[float] | None = None,
+                 dt: float | None = None, skin: float | None = None, num_threads: int | None = None,
+                 max_overlap_ratio: float | None = None, insert_overlap_ratio: float | None = None,
+                 reference_velocity: float | None = None, _ptr=None):
         if _ptr is not None:  # from a snapshot
             self._d = ffi.gc(_ptr, lib.dem_domain_destroy)
             return
-        d = lib.dem_default_domain_def()
-        for a in range(3):
-            d.lo[a], d.hi[a], d.periodic[a], d.gravity[a] = lo[a], hi[a], int(bool(periodic[a])), gravity[a]
-        d.dt, d.skin, d.num_threads = dt, skin, int(num_threads)
-        d.max_overlap_ratio, d.insert_overlap_ratio, d.reference_velocity = max_overlap_ratio, insert_overlap_ratio, reference_velocity
+        d = c_definition(lib.dem_default_domain_def, "dem_domain_def *", lo=lo, hi=hi,
+                         periodic=None if periodic is None else [int(bool(p)) for p in periodic], gravity=gravity,
+                         dt=dt, skin=skin, num_threads=None if num_threads is None else int(num_threads),
+                         max_overlap_ratio=max_overlap_ratio, insert_overlap_ratio=insert_overlap_ratio,
+                         reference_velocity=reference_velocity)
         out, msg = ffi.new("dem_domain **"), ffi.new("char[512]")
-        check(lib.dem_domain_create(ffi.new("dem_domain_def *", d), out, msg, 512), message=ffi.string(msg).decode())
+        check(lib.dem_domain_create(d, out, msg, 512), message=ffi.string(msg).decode())
         self._d = ffi.gc(out[0], lib.dem_domain_destroy)
 
     @classmethod
@@ -124,9 +143,11 @@ class Domain:
         self._check(lib.dem_domain_set_seed(self._d, int(value)))
 
     # ---- materials and pairs ---------------------------------------------------------------
-    def add_material(self, youngs_modulus: float = 5e6, poisson_ratio: float = 0.25, density: float = 2500.0) -> int:
-        m = ffi.new("dem_material_def *", {"youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
-                                            "density": density})
+    def add_material(self, youngs_modulus: float | None = None, poisson_ratio: float | None = None,
+                     density: float | None = None) -> int:
+        """A material (None: libdem's default, dem_default_material_def: E 5 MPa, nu 0.25, 2500 kg/m^3)."""
+        m = c_definition(lib.dem_default_material_def, "dem_material_def *", youngs_modulus=youngs_modulus,
+                         poisson_ratio=poisson_ratio, density=density)
         out = ffi.new("int *")
         self._check(lib.dem_material_create(self._d, m, out))
         return out[0]
@@ -135,14 +156,18 @@ class Domain:
     def material_count(self) -> int:
         return lib.dem_material_count(self._d)
 
-    def set_pair(self, a: int, b: int, restitution: float = 0.5, friction: float = 0.5, rolling_friction: float = 0.0,
-                 rolling_model: str = "epsd2", rolling_damping: float = 0.0):
-        if rolling_model not in ROLLING_MODELS:
+    def set_pair(self, a: int, b: int, restitution: float | None = None, friction: float | None = None,
+                 rolling_friction: float | None = None, rolling_model: str | None = None,
+                 rolling_damping: float | None = None):
+        """Contact constants of materials a and b (None: libdem's default, dem_default_pair_def:
+        restitution 0.5, friction 0.5, no rolling friction, EPSD2)."""
+        if rolling_model is not None and rolling_model not in ROLLING_MODELS:
             raise DemInvalidArgument(f"rolling_model must be one of {sorted(ROLLING_MODELS)}, got {rolling_model!r}",
                                      "DEM_ERR_INVALID_ARGUMENT")
-        p = ffi.new("dem_pair_def *", {"restitution": restitution, "friction": friction,
-                                        "rolling_friction": rolling_friction,
-                                        "rolling_model": ROLLING_MODELS[rolling_model], "rolling_damping": rolling_damping})
+        p = c_definition(lib.dem_default_pair_def, "dem_pair_def *", restitution=restitution, friction=friction,
+                         rolling_friction=rolling_friction,
+                         rolling_model=None if rolling_model is None else ROLLING_MODELS[rolling_model],
+                         rolling_damping=rolling_damping)
         self._check(lib.dem_pair_set(self._d, a, b, p))
 
     def get_pair(self, a: int, b: int) -> dict:
@@ -273,8 +298,10 @@ class Domain:
         return int(h[0])
 
     # ---- walls ------------------------------------------------------------------------------
-    def add_plane_wall(self, axis: int = 2, side: int = 1, position: float = 0.0, material: int = 0,
-                       velocity: Sequence[float] = (0.0, 0.0, 0.0)):
+    def add_plane_wall(self, axis: int | None = None, side: int | None = None, position: float | None = None,
+                       material: int | None = None, velocity: Sequence[float] | None = None):
+        """A plane wall (None: libdem's default, dem_default_plane_wall_def: the floor z >= 0,
+        material 0, at rest)."""
         from .walls import PlaneWall
         return PlaneWall._create(self, axis, side, position, material, velocity)
 

@@ -18,12 +18,11 @@ class PlaneWall:
 
     @classmethod
     def _create(cls, domain, axis, side, position, material, velocity):
-        w = lib.dem_default_plane_wall_def()
-        w.axis, w.side, w.position, w.material = int(axis), int(side), float(position), int(material)
-        for a in range(3):
-            w.velocity[a] = velocity[a]
+        from .domain import c_definition
+        w = c_definition(lib.dem_default_plane_wall_def, "dem_plane_wall_def *", axis=axis, side=side,
+                         position=position, material=material, velocity=velocity)
         out = ffi.new("int *")
-        domain._check(lib.dem_plane_wall_add(domain._d, ffi.new("dem_plane_wall_def *", w), out))
+        domain._check(lib.dem_plane_wall_add(domain._d, w, out))
         return cls(domain, out[0])
 
     def set_velocity(self, velocity: Sequence[float]):

@@ -14,8 +14,11 @@ from .candidates import BASE_PARAMETERS, Candidate, registry
 from .quantities import Observation, ObservationError, observation, preset_conditions
 from .surrogates import load_or_train
 
-DEFAULT_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_aor_tiny.h5",
-                  "data/campaigns/diag_hopper_tiny.h5")
+# the shipped diagnosis stores, one per rig: at the rigs' tiny presets (the CI's, quick to remake)
+# and at their default presets (the ones measurements made with the default rigs are compared with)
+TINY_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_aor_tiny.h5",
+               "data/campaigns/diag_hopper_tiny.h5")
+DEFAULT_STORES = TINY_STORES
 
 
 @dataclass

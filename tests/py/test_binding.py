@@ -153,3 +153,29 @@ def test_integer_arrays_refuse_fractions():
     with pytest.raises(pydem.DemInvalidArgument, match=r"triangles must be whole numbers, got \[2.5\]"):
         d.add_mesh_wall((verts, np.array([[0, 1, 2.5]])), material=m)
     d.add_mesh_wall((verts, np.array([[0, 1, 2.0]])), material=m)  # whole floats are fine
+
+
+def test_python_defaults_are_libdem_s():
+    """pydem keeps no defaults of its own: every optional argument is None and takes libdem's
+    dem_default_*_def value (one owner per default)."""
+    import inspect
+    from pydem import _lib
+    for fn in (pydem.Domain.__init__, pydem.Domain.add_material, pydem.Domain.set_pair, pydem.Domain.add_plane_wall):
+        for name, prm in inspect.signature(fn).parameters.items():
+            if name not in ("self", "a", "b", "_ptr"):
+                assert prm.default is None, (fn.__name__, name)
+    d = pydem.Domain()
+    c = _lib.dem_default_domain_def()
+    s = d.settings
+    assert (s["dt"], s["skin"], s["num_threads"], s["max_overlap_ratio"]) == (c.dt, c.skin, c.num_threads, c.max_overlap_ratio)
+    assert s["gravity"] == tuple(c.gravity) and s["lo"] == tuple(c.lo) and s["hi"] == tuple(c.hi)
+    m = d.add_material()
+    d.set_pair(m, m)
+    p, cp = d.get_pair(m, m), _lib.dem_default_pair_def()
+    assert (p["restitution"], p["friction"], p["rolling_friction"]) == (cp.restitution, cp.friction, cp.rolling_friction)
+    w = d.add_plane_wall()
+    # the default wall is the floor z >= 0: a sphere pressed 1 um into it (the default insertion
+    # tolerance allows 1e-3 of its radius) pushes it down
+    d.add_particles(np.array([[0.05, 0.05, 0.002 - 1e-6]]), 0.002, m)
+    d.step(0)
+    assert w.force[2] < 0

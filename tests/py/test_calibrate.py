@@ -20,8 +20,8 @@ HEADER = "material,test,quantity,value,uncertainty,unit,conditions,use,source\n"
 @pytest.fixture(scope="module")
 def tiny():
     """The shipped tiny diagnosis stores (their nets are cached beside them: no training)."""
-    from pydem.calibration.setup import DEFAULT_STORES, load_setup
-    return load_setup([ROOT / s for s in DEFAULT_STORES], say=lambda *_: None)
+    from pydem.calibration.setup import TINY_STORES, load_setup
+    return load_setup([ROOT / s for s in TINY_STORES], say=lambda *_: None)
 
 
 def pseudo_measurements(tmp_path, tiny, truth):
@@ -65,10 +65,11 @@ def test_posterior_covers_the_truth_and_the_native_window_is_numpy_s(tiny, tmp_p
 
 
 def test_calibrate_command_writes_report_nets_and_window(tiny, tmp_path):
+    from pydem.calibration.setup import TINY_STORES
     f, _, _ = pseudo_measurements(tmp_path, tiny, {"friction": 0.4, "rolling_friction": 0.2, "restitution": 0.6})
     out = tmp_path / "cal"
     r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", str(f), "--material", "m", "--out", str(out),
-                        "--samples", "16384"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+                        "--samples", "16384", "--stores", *TINY_STORES], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr
     data = json.loads((out / "calibration.json").read_text())
     assert set(data["parameters"]) == {"friction", "rolling_friction", "restitution"}
@@ -105,6 +106,7 @@ def test_a_row_at_another_condition_than_a_fixed_store_is_left_out(tmp_path):
 
 
 def test_compare_matches_rows_by_condition(tiny, tmp_path):
+    from pydem.calibration.setup import TINY_STORES
     from pydem.calibration.compare import dem_rows, surrogate_rows
     from pydem.calibration.setup import observations_from_file
     truth = {"friction": 0.5, "rolling_friction": 0.3, "restitution": 0.5}
@@ -121,7 +123,8 @@ def test_compare_matches_rows_by_condition(tiny, tmp_path):
     assert [r["label"] for r in rows] == [o.label for o in ps if o.conditions["preshear_stress"] == 2000.0]
     assert rows[0]["model"] == 0.55 and len(unmatched) == len(obs) - 1
     r = subprocess.run([sys.executable, "-m", "pydem", "compare", str(f), "--material", "m", "--params",
-                        ",".join(f"{k}={v}" for k, v in truth.items())], cwd=ROOT, capture_output=True, text=True)
+                        ",".join(f"{k}={v}" for k, v in truth.items()), "--stores", *TINY_STORES], cwd=ROOT,
+                       capture_output=True, text=True)
     assert r.returncode == 0 and "RMSE of relative residuals 0.000" in r.stdout, r.stdout + r.stderr
 
 

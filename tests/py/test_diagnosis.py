@@ -139,15 +139,16 @@ def test_report_and_json_from_the_shipped_tiny_stores(tmp_path):
     """`pydem diagnose` end to end on the shipped tiny stores and a synthetic measurement file:
     exit 0, the JSON keys of the contract, a self-contained HTML page with its images."""
     from pydem.calibration import synthetic
-    from pydem.calibration.setup import DEFAULT_STORES, load_setup
-    setup = load_setup([ROOT / s for s in DEFAULT_STORES], say=lambda *a: None)
+    from pydem.calibration.setup import TINY_STORES, load_setup
+    setup = load_setup([ROOT / s for s in TINY_STORES], say=lambda *a: None)
     rng = np.random.default_rng(0)
     truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, "cohesion_sjkr", min_fraction=0.6)
     obs = synthetic.surrogate_set(setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets))
     meas = tmp_path / "m.csv"
     synthetic.to_csv(meas, "syn", obs, truth, "test")
     out = tmp_path / "diag"
-    r = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", "syn", "--out", str(out)],
+    r = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", "syn", "--out", str(out),
+                        "--stores", *TINY_STORES],
                        cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     d = json.loads((out / "diagnosis.json").read_text())
@@ -162,8 +163,8 @@ def test_report_and_json_from_the_shipped_tiny_stores(tmp_path):
 
 def test_measurements_that_match_no_campaign_are_refused(tmp_path):
     from pydem.calibration.quantities import ObservationError
-    from pydem.calibration.setup import DEFAULT_STORES, load_setup, observations_from_file
-    setup = load_setup([ROOT / DEFAULT_STORES[2]], say=lambda *a: None)  # the hopper store only
+    from pydem.calibration.setup import TINY_STORES, load_setup, observations_from_file
+    setup = load_setup([ROOT / TINY_STORES[2]], say=lambda *a: None)  # the hopper store only
     meas = tmp_path / "m.csv"
     meas.write_text("material,test,quantity,value,uncertainty,unit,conditions,use,source\n"
                     "x,aor,angle_of_repose,30,0.5,deg,,calibrate,\n")
@@ -178,8 +179,8 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     nets, so the verdicts are fixed: a strong cohesion is named, a null set raises no alarm, and
     a 25 % density mismatch shows as misfit."""
     from pydem.calibration import synthetic
-    from pydem.calibration.setup import DEFAULT_STORES, load_setup
-    setup = load_setup([ROOT / s for s in DEFAULT_STORES], say=lambda *a: None)
+    from pydem.calibration.setup import TINY_STORES, load_setup
+    setup = load_setup([ROOT / s for s in TINY_STORES], say=lambda *a: None)
     rows = synthetic.validate(setup, {"null": 3, "unexplained": 1}, seed=11, say=lambda *a: None)
     rng = np.random.default_rng(12)
     truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, "cohesion_sjkr", min_fraction=0.8)
