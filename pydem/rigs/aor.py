@@ -27,6 +27,8 @@ class AorConfig:
     particles: int = knob(3000, 20, 2_000_000, "", "number of spheres")
     diameter: float = knob(3e-3, 1e-4, 0.1, "m", "mean sphere diameter")
     size_spread: float = knob(0.1, 0.0, 0.5, "", "diameters uniform in d (1 +- spread)")
+    psd_sizes: list = knob([], 1e-6, 1.0, "m", "size table: sieve sizes, increasing (replaces size_spread; docs/rigs.md)")
+    psd_passing: list = knob([], 0.0, 1.0, "", "size table: cumulative mass fraction passing each size, 0 ... 1")
     cylinder_radius: float = knob(0.025, 1e-3, 1.0, "m", "inner radius of the lifted cylinder")
     base_radius: float = knob(0.07, 1e-3, 5.0, "m", "radius of the base disk the heap forms on")
     base_friction: float = knob(0.9, 0.0, 2.0, "", "sliding friction sphere-base (a rough base)")
@@ -63,7 +65,7 @@ class AngleOfRepose:
         p = params_from(c.params, params)
         rng = np.random.default_rng(seed)
         dmean, rc = c.diameter, c.cylinder_radius
-        radii = size_distribution(rng, c.particles, dmean, c.size_spread)
+        radii = size_distribution(rng, c.particles, dmean, c.size_spread, c.psd_sizes, c.psd_passing)
         # fill height: the lattice (spacing 1.05 d_max) up to the particle count, inside the cylinder
         spacing = 1.05 * 2 * radii.max()
         inner = rc - 0.55 * spacing

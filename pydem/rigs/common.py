@@ -73,9 +73,33 @@ def lattice_fill(rng: np.random.Generator, lo, hi, spacing: float, inside: Calla
     return g
 
 
-def size_distribution(rng: np.random.Generator, n: int, diameter: float, spread: float) -> np.ndarray:
-    """Radii uniform in diameter (1 +- spread) / 2."""
-    return 0.5 * diameter * (1.0 + spread * rng.uniform(-1.0, 1.0, n))
+def size_distribution(rng: np.random.Generator, n: int, diameter: float, spread: float, sizes=(), passing=()) -> np.ndarray:
+    """Radii: diameters uniform in diameter (1 +- spread), or, given a size table (sieve sizes
+    and the cumulative mass fraction passing each, linear between them), drawn from it."""
+    if len(sizes) == 0 and len(passing) == 0:
+        return 0.5 * diameter * (1.0 + spread * rng.uniform(-1.0, 1.0, n))
+    return 0.5 * diameters_from_table(rng, n, sizes, passing)
+
+
+def diameters_from_table(rng: np.random.Generator, n: int, sizes, passing) -> np.ndarray:
+    """n diameters whose *mass* distribution is the table's: cumulative mass fraction passing
+    P(d) linear between the sieve sizes (mass uniform in d within each cut). A cut's share of
+    the spheres is its mass share times the mean of d^-3 over it (number ~ mass / d^3), and
+    within a cut d is drawn with density ~ d^-3 (inverse CDF)."""
+    from .config import ConfigError
+    d, cum = np.asarray(sizes, float), np.asarray(passing, float)
+    if d.size != cum.size or d.size < 2:
+        raise ConfigError(f"psd_sizes and psd_passing need the same number of entries, at least 2 (got {d.size}, {cum.size})")
+    if not (np.all(d > 0) and np.all(np.diff(d) > 0)):
+        raise ConfigError(f"psd_sizes must be positive and increasing, got {list(d)}")
+    if not (np.all(np.diff(cum) >= 0) and cum[0] == 0.0 and cum[-1] == 1.0):
+        raise ConfigError(f"psd_passing must rise from 0 (at the smallest size) to 1 (at the largest), got {list(cum)}")
+    lo, hi, mass = d[:-1], d[1:], np.diff(cum)
+    inv2 = lo ** -2 - hi ** -2
+    weight = mass / (hi - lo) * 0.5 * inv2  # number of spheres per cut, up to a constant
+    cut = rng.choice(len(mass), size=n, p=weight / weight.sum())
+    u = rng.uniform(0.0, 1.0, n)
+    return (lo[cut] ** -2 - u * inv2[cut]) ** -0.5
 
 
 class Stepper:

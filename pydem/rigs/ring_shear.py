@@ -36,6 +36,8 @@ class RingShearConfig:
     particles: int = knob(4000, 50, 2_000_000, "", "number of spheres")
     diameter: float = knob(3e-3, 1e-4, 0.1, "m", "mean sphere diameter")
     size_spread: float = knob(0.1, 0.0, 0.5, "", "diameters uniform in d (1 +- spread)")
+    psd_sizes: list = knob([], 1e-6, 1.0, "m", "size table: sieve sizes, increasing (replaces size_spread; docs/rigs.md)")
+    psd_passing: list = knob([], 0.0, 1.0, "", "size table: cumulative mass fraction passing each size, 0 ... 1")
     inner_radius: float = knob(0.025, 1e-3, 2.0, "m", "trough inner radius Ri")
     outer_radius: float = knob(0.052, 1e-3, 2.0, "m", "trough outer radius Ro (width >= ~10 d)")
     bars: int = knob(12, 0, 200, "", "radial bars on the trough floor and under the lid (each)")
@@ -142,7 +144,7 @@ class Tester:
         self.area = math.pi * (ro ** 2 - ri ** 2)
         self.moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
         self.omega = c.shear_speed / (0.5 * (ri + ro))
-        radii = size_distribution(rng, c.particles, dm, c.size_spread)
+        radii = size_distribution(rng, c.particles, dm, c.size_spread, c.psd_sizes, c.psd_passing)
         spacing = 1.05 * 2 * radii.max()
         ring = math.pi * ((ro - 0.55 * spacing) ** 2 - (ri + 0.55 * spacing) ** 2) / spacing ** 2
         fill_top = spacing * (c.particles / max(ring * 0.7, 1.0) + 2) + c.bar_height
