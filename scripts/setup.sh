@@ -13,10 +13,12 @@ pkg-config --exists hdf5-serial 2>/dev/null || pkg-config --exists hdf5 2>/dev/n
 pkg-config --exists libpng 2>/dev/null || missing="$missing libpng-dev"
 [ -f /usr/include/cmocka.h ] || [ -f /usr/local/include/cmocka.h ] || missing="$missing libcmocka-dev"
 command -v valgrind >/dev/null 2>&1 || missing="$missing valgrind"
+command -v chromium >/dev/null 2>&1 || missing="$missing chromium"  # the reports' browser test
 if [ -n "$missing" ]; then
     if ! command -v apt-get >/dev/null 2>&1; then
         echo "setup: missing:$missing (Debian package names)." >&2
-        echo "setup: install HDF5 and libpng with their headers and pkg-config files, cmocka and valgrind" >&2
+        echo "setup: install HDF5 and libpng with their headers and pkg-config files, cmocka, valgrind and" >&2
+        echo "       chromium (the reports' browser test)" >&2
         echo "       with this system's package manager, then run make again." >&2
         exit 1
     fi

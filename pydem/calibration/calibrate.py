@@ -41,7 +41,7 @@ class Calibration:
     def as_dict(self) -> dict:
         post = self.fit.posterior
         return {"material": self.material, "fit": self.summary(),
-                "parameters": {n: {k: v for k, v in p.items()} for n, p in post.get("parameters", {}).items()},
+                "parameters": {n: dict(p) for n, p in post.get("parameters", {}).items()},
                 "correlation": {"names": post.get("names"), "matrix": post.get("correlation")},
                 "posterior_samples": post.get("samples"), "posterior_ess": post.get("ess"),
                 "admissible_window": {k: v for k, v in self.screening.items() if k != "points"},

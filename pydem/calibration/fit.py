@@ -177,7 +177,10 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     sd = np.sqrt(var)
     cov_p = ((x - mean) * w[:, None]).T @ (x - mean)
     corr = cov_p / np.outer(sd, sd)
-    out = {"samples": int(len(x)), "ess": ess, "parameters": {}, "correlation": corr.tolist(), "names": fit.names}
+    # 1,000 draws from the posterior (resampled by weight): for plots, not for the numbers above
+    draws = x[np.random.default_rng(seed + 1).choice(len(x), size=1000, p=w)]
+    out = {"samples": int(len(x)), "ess": ess, "parameters": {}, "correlation": corr.tolist(), "names": fit.names,
+           "draws": draws}
     for j, name in enumerate(fit.names):
         order = np.argsort(x[:, j])
         cw = np.cumsum(w[order])

@@ -95,6 +95,52 @@ def plot_measured_vs_model(observations, sigma, models: dict[str, np.ndarray]) -
     return _png(fig)
 
 
+def plot_parameters(fit, window: dict | None) -> bytes:
+    """Every pair of free parameters over the campaign box: posterior draws (grey), seed 000's
+    admissible combinations (blue, when there are any; said so when there are none) and the
+    best estimate (red star)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names, draws = fit.names, fit.posterior.get("draws")
+    k = len(names)
+    pts = (window or {}).get("points")
+    pts = pts[:: max(1, len(pts) // 2000)] if pts is not None and len(pts) else None
+    fig, axes = plt.subplots(k - 1, k - 1, figsize=(2.9 * (k - 1), 2.7 * (k - 1)), squeeze=False, layout="constrained")
+    for i in range(1, k):
+        for j in range(k - 1):
+            ax = axes[i - 1][j]
+            if j >= i:
+                ax.set_visible(False)
+                continue
+            if draws is not None:
+                ax.scatter(draws[:, j], draws[:, i], s=3, color="0.55", alpha=0.5, label="posterior draws")
+            if pts is not None:
+                ax.scatter(pts[:, j], pts[:, i], s=3, color="C0", alpha=0.5, label="within the window")
+            ax.plot(fit.best[j], fit.best[i], "*", color="C3", ms=12, label="best estimate")
+            ax.set_xlim(fit.lo[j], fit.hi[j])
+            ax.set_ylim(fit.lo[i], fit.hi[i])
+            ax.set_xlabel(names[j].split(".")[-1], fontsize=8)
+            ax.set_ylabel(names[i].split(".")[-1], fontsize=8)
+            ax.tick_params(labelsize=7)
+    axes[0][0].legend(fontsize=6, loc="best")
+    n_adm = (window or {}).get("admissible")
+    note = "" if n_adm is None else (f"; {n_adm:,} of {window['samples']:,} combinations within ±{100 * window['window']:g} %"
+                                      if n_adm else f"; no combination within ±{100 * window['window']:g} % of every value")
+    fig.suptitle(f"parameters over the campaign box{note}", fontsize=10)
+    return _png(fig)
+
+
+def nets_section(nets: dict) -> tuple[str, str, str]:
+    """The surrogates' quality: hold-out R^2 and RMSE against single runs, and how that RMSE
+    splits into the rig's seed scatter and the net's own error (docs/diagnosis.md §3)."""
+    rows = [[q.key, n.runs, ", ".join(x.split(".")[-1] for x in n.input_names), _g(n.r2, ".3f"), _g(n.rmse, ".3g"),
+             _g(n.seed_sd, ".3g") + ("" if math.isfinite(n.scatter) else " (all of the RMSE)"), _g(n.net_error, ".3g")]
+            for q, n in sorted(nets.items(), key=lambda kv: kv[0].key)]
+    md, h = _table(rows, ["quantity", "rows", "inputs", "hold-out R²", "hold-out RMSE", "seed scatter", "net error"])
+    return "Surrogates", md, h
+
+
 def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     """The measured-vs-model plot (base model, and with the effect) and the candidates' statistics."""
     import matplotlib
@@ -246,7 +292,8 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
     data["context"] = context or {}
     (out / "calibration.json").write_text(json.dumps(strict_json(data), indent=1, allow_nan=False))
     plots = {"residuals.png": plot_measured_vs_model(c.observations, c.model.sigma,
-                                                      {"calibrated model": c.model.predict(c.fit.best)})}
+                                                      {"calibrated model": c.model.predict(c.fit.best)}),
+             "parameters.png": plot_parameters(c.fit, c.screening)}
     for name, png in plots.items():
         (out / name).write_bytes(png)
     pts = c.screening.get("points")
@@ -261,6 +308,7 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
     sections = [("Fit", line, f"<p class='verdict'>{html.escape(line)}</p>"),
                 parameter_section(data["parameters"], data["admissible_window"], "Parameters (posterior)"),
                 residual_section(data["residuals"], "Residuals")]
+    sections.append(nets_section({o.quantity: n for o, n in zip(c.observations, c.model.nets)}))
     names = data["correlation"]["names"] or []
     if names:
         rows = [[a] + [_g(v, "+.2f") for v in row] for a, row in zip(names, data["correlation"]["matrix"])]
