@@ -63,5 +63,7 @@ def main(args) -> int:
         from .cli import ProgressLine
         context["confirm"] = confirm(setup, c.fit, obs, args.threads, say, ProgressLine())
     path = report.write_calibration(c, out, context)
+    from .calibration import material_card
+    material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates), out)
     say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
     return 0

@@ -73,6 +73,9 @@ def main(args) -> int:
         fit = d.after if d.after is not None else d.base
         context["confirm"] = confirm(setup, fit, obs, args.threads, say, ProgressLine())
     path = report.write(d, args.out, context)
+    from .calibration import material_card  # the final model: with the effect when one was added
+    material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
+                                           setup.candidates), args.out)
     say(f"verdict: {d.verdict}" + (f" ({d.effect})" if d.effect else "") + f" — {report.verdict_line(d)}")
     say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
     return 0

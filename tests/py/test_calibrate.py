@@ -87,6 +87,14 @@ def test_calibrate_command_writes_report_nets_and_window(tiny, tmp_path):
     x = np.random.default_rng(0).uniform(net.lo, net.hi, (100, len(net.lo)))
     assert np.allclose(native(x), net(x), rtol=1e-12, atol=1e-12)
     assert (out / "nets/c/mlp_aor__angle_of_repose.c").exists()
+    # the material card: the estimate as JSON and as LIGGGHTS / LAMMPS input
+    card = json.loads((out / "material_card.json").read_text())
+    mu = data["parameters"]["friction"]["estimate"]
+    assert card["parameters"]["friction"]["value"] == mu and card["parameters"]["friction"]["calibrated"]
+    assert card["parameters"]["wall_friction"]["value"] == mu  # not freed: the base model's assumption
+    lig = (out / "material_card.liggghts").read_text()
+    assert f"coefficientFriction peratomtypepair 2 {mu:.6g} {mu:.6g}" in lig and "rolling_friction epsd2" in lig
+    assert "pair_style granular" in (out / "material_card.lammps").read_text()
 
 
 def test_a_row_at_another_condition_than_a_fixed_store_is_left_out(tmp_path):
