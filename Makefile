@@ -65,6 +65,9 @@ $(BUILD)/dem.pc: FORCE
 setup:
 	@sh scripts/setup.sh
 
+# every malloc/calloc/realloc of the static library counted (tests/c/test_no_alloc.c)
+$(BUILD)/tests/test_no_alloc: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc
+
 $(BUILD)/tests/%: tests/c/%.c $(wildcard tests/c/*.h) $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)

@@ -122,6 +122,7 @@ void dem_domain_destroy(dem_domain *d)
     free(d->index_of_id);
     free(d->walls);
     dem_mesh_free_all(d);
+    dem_neighbor_free_scratch(d);
     free_pair_list(&d->pairs_cur);
     free_pair_list(&d->pairs_old);
     free_wall_list(&d->walls_cur);

@@ -76,6 +76,7 @@ typedef struct tri_list {
     int64_t n_rows;          /* particles covered */
     int64_t count, capacity;
     int64_t *start;          /* n + 1 */
+    int64_t start_cap;       /* entries allocated for start (grown, never shrunk: no allocation in a warm step) */
     int32_t *mesh, *tri;
     uint8_t *active;
     double *hist;            /* 6 per entry: tangential spring (3), rolling torque (3) */
@@ -94,6 +95,7 @@ typedef struct pair_list {
     int64_t n_rows;       /* particles covered */
     int64_t count, capacity;
     int64_t *start;       /* n_rows + 1 */
+    int64_t start_cap;    /* entries allocated for start */
     int32_t *j;
     uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
     uint8_t *active;
@@ -104,6 +106,7 @@ typedef struct pair_list {
 typedef struct wall_list {
     int64_t count, capacity;
     int64_t *start;       /* n + 1 */
+    int64_t start_cap;    /* entries allocated for start */
     int32_t *wall;
     double *xi, *mr;      /* 3 per entry */
     double *force;        /* 3 per entry: force on the particle, last step */
@@ -135,6 +138,10 @@ struct dem_domain {
     /* walls */
     int n_walls, cap_walls;
     plane_wall *walls;
+
+    /* the neighbour build's per-thread scan buffers (neighbor.c), kept between builds */
+    void *scan;
+    int n_scan;
 
     /* mesh walls */
     int n_meshes, cap_meshes;
@@ -257,6 +264,9 @@ void dem_mesh_total_force(const dem_domain *d, int m, double force[3]);
 /* mesh_mean_force.c: add the force of the step just computed, times dt, to every averaging mesh */
 void dem_meshes_accumulate_mean_force(dem_domain *d, double dt);
 
+/* neighbor.c: frees the build's scratch */
+void dem_neighbor_free_scratch(dem_domain *d);
+
 /* step.c */
 double dem_rayleigh_time(dem_domain *d);
 
@@ -290,6 +300,9 @@ int dem_effect_find(const char *name);
 
 /* small helpers */
 void *dem_realloc_array(void *p, size_t count, size_t elem);
+/* Row offsets of a list for n rows (n + 1 entries) in *start, grown (by half again) only when
+ * *cap is too small, so a build at the same size allocates nothing; 0: out of memory. */
+int dem_reserve_rows(int64_t **start, int64_t *cap, int64_t n);
 /* Realloc every array to count elements of elem bytes; 0 if any failed (those that
  * succeeded stay valid and grown). */
 int dem_realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem);

@@ -141,9 +141,8 @@ dem_status dem_mesh_candidates(dem_domain *d)
     d->tris_cur = tmp;
     tri_list *tl = &d->tris_cur;
     const tri_list *old = &d->tris_old;
-    int64_t *start = dem_realloc_array(tl->start, (size_t)n + 1, sizeof *start);
-    if (!start) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
-    tl->start = start;
+    if (!dem_reserve_rows(&tl->start, &tl->start_cap, n)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    int64_t *start = tl->start;
     start[0] = 0;
     tl->count = 0;
     d->mesh_disp = 0.0;

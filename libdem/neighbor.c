@@ -138,6 +138,18 @@ typedef struct scan_buffer {
     int failed; /* out of memory */
 } scan_buffer;
 
+void dem_neighbor_free_scratch(dem_domain *d)
+{
+    scan_buffer *b = d->scan;
+    for (int p = 0; p < d->n_scan; p++) {
+        free(b[p].j);
+        free(b[p].image);
+    }
+    free(d->scan);
+    d->scan = NULL;
+    d->n_scan = 0;
+}
+
 static int scan_buffer_grow(scan_buffer *b)
 {
     int64_t c = b->cap ? 2 * b->cap : 1024;
@@ -318,14 +330,19 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;
 
-    /* pair list: each thread scans its rows into its buffer; prefix; copy + histories */
-    int64_t *start = dem_realloc_array(pl->start, (size_t)n + 1, sizeof *start);
-    scan_buffer *bufs = calloc((size_t)nt, sizeof *bufs);
-    if (!start || !bufs) {
-        free(bufs);
-        return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    /* pair list: each thread scans its rows into its buffer; prefix; copy + histories (the
+     * buffers stay with the domain: a build at a size seen before allocates nothing) */
+    if (d->n_scan < nt) {
+        scan_buffer *grown = dem_realloc_array(d->scan, (size_t)nt, sizeof *grown);
+        if (!grown) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+        memset(grown + d->n_scan, 0, (size_t)(nt - d->n_scan) * sizeof *grown);
+        d->scan = grown;
+        d->n_scan = nt;
     }
-    pl->start = start;
+    scan_buffer *bufs = d->scan;
+    for (int p = 0; p < nt; p++) bufs[p].count = bufs[p].failed = 0;
+    if (!dem_reserve_rows(&pl->start, &pl->start_cap, n)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    int64_t *start = pl->start;
     int parts = 1; /* rows [n p / parts, n (p + 1) / parts) went to buffer p */
 #pragma omp parallel num_threads(nt)
     {
@@ -368,11 +385,6 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
                 }
         }
     }
-    for (int p = 0; p < nt; p++) {
-        free(bufs[p].j);
-        free(bufs[p].image);
-    }
-    free(bufs);
     if (!ok) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the pair list");
 
     /* per-entry force scratch and the transposed list (entries where a particle is j) */
@@ -411,9 +423,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     /* wall candidates, grouped by particle */
     wall_list *wl = &d->walls_cur;
     const wall_list *wold = &d->walls_old;
-    int64_t *wstart = dem_realloc_array(wl->start, (size_t)n + 1, sizeof *wstart);
-    if (!wstart) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
-    wl->start = wstart;
+    if (!dem_reserve_rows(&wl->start, &wl->start_cap, n)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
+    int64_t *wstart = wl->start;
     int64_t wc = 0;
     wstart[0] = 0;
     for (int64_t i = 0; i < n; i++) {

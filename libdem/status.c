@@ -57,6 +57,17 @@ void *dem_realloc_array(void *p, size_t count, size_t elem)
     return realloc(p, count * elem);
 }
 
+int dem_reserve_rows(int64_t **start, int64_t *cap, int64_t n)
+{
+    if (*start && n + 1 <= *cap) return 1;
+    const int64_t c = n + 1 + (n + 1) / 2;
+    int64_t *s = dem_realloc_array(*start, (size_t)c, sizeof *s);
+    if (!s) return 0;
+    *start = s;
+    *cap = c;
+    return 1;
+}
+
 int dem_realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem)
 {
     int ok = 1;
