@@ -1,5 +1,6 @@
 """A corrupted snapshot is refused, never restarted from a different state: every dataset carries
-a Fletcher-32 checksum and the object headers (attributes) HDF5's own checksums. 300 random
+a Fletcher-32 checksum and the object headers (attributes, chunk index: the HDF5 1.10 format)
+HDF5's own checksums. 300 random
 single-bit flips: each either fails to load with an error naming the file, or (a flip in unused
 bytes) loads and runs bitwise like the original. Before the checksums, 113 of 300 such flips
 loaded and ran from a different state."""
