@@ -45,6 +45,13 @@ typedef struct dem_stress {
 DEM_API dem_region dem_default_region(void); /* a unit box at the origin */
 DEM_API dem_status dem_region_stress(dem_domain *domain, const dem_region *region, dem_stress *out);
 
+/* Every contact with overlap > 0 of the current state (forces brought up to date first when
+ * needed, as dem_domain_step(d, 0)): particle pairs, plane walls and mesh triangles. *count
+ * gets their number; up to `capacity` of them are written to out (out may be NULL with
+ * capacity 0 to ask for the number). DEM_ERR_INVALID_ARGUMENT when capacity < *count (the
+ * first `capacity` are written). */
+DEM_API dem_status dem_contacts_get(dem_domain *domain, dem_contact *out, int64_t capacity, int64_t *count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -71,6 +71,25 @@ typedef struct dem_diagnostics {
     double momentum[3];          /* kg m/s */
 } dem_diagnostics;
 
+/* One contact of the current state (dem_contacts_get), seen from particle i. */
+typedef enum dem_contact_kind {
+    DEM_CONTACT_PARTICLE = 0, /* partner: particle id j */
+    DEM_CONTACT_PLANE = 1,    /* partner: plane wall `wall` */
+    DEM_CONTACT_MESH = 2      /* partner: mesh wall `wall`, its triangle `triangle` */
+} dem_contact_kind;
+
+typedef struct dem_contact {
+    dem_particle_id i;     /* the particle */
+    dem_particle_id j;     /* the partner particle (-1 for a wall) */
+    int32_t kind;          /* dem_contact_kind */
+    int32_t wall;          /* plane or mesh wall index (-1 for a particle) */
+    int64_t triangle;      /* mesh triangle (-1 otherwise) */
+    double point[3];       /* m, the contact point: the middle of the overlap (pairs), on the surface (walls) */
+    double normal[3];      /* unit normal, from the partner towards i */
+    double force[3];       /* N, the contact force on i (the partner gets the opposite) */
+    double overlap;        /* m */
+} dem_contact;
+
 /* Accumulated wall-clock time per phase since creation or the last reset. */
 typedef struct dem_profile {
     double neighbor_s;     /* cell binning, sorting, Verlet list build, history transfer */
