@@ -18,9 +18,15 @@ OPT     ?= -O3 -fno-math-errno -fno-trapping-math $(ARCH_OPT)
 # The screening kernel (mlp_screen.c) is one long vector loop: AVX-512 when this machine has it
 # (ARCH_OPT_WIDE= to turn off; it follows ARCH_OPT otherwise).
 ARCH_OPT_WIDE ?= $(if $(ARCH_OPT),$(shell grep -qw avx512f /proc/cpuinfo 2>/dev/null && $(CC) -march=x86-64-v4 -x c -c /dev/null -o /dev/null 2>/dev/null && echo -march=x86-64-v4 -mprefer-vector-width=512))
-# HDF5 (snapshots) and libpng (images), installed by scripts/setup.sh
-DEPS_CFLAGS := $(shell pkg-config --cflags hdf5-serial libpng 2>/dev/null)
-DEPS_LIBS   := $(shell pkg-config --libs hdf5-serial libpng 2>/dev/null || echo -lhdf5 -lpng)
+# HDF5 (snapshots) and libpng (images), installed by scripts/setup.sh. HDF5=0 / PNG=0 build
+# without them (for embedding): those calls then return DEM_ERR_UNSUPPORTED.
+HDF5 ?= 1
+PNG  ?= 1
+DEP_PKGS    := $(if $(filter 1,$(HDF5)),hdf5-serial) $(if $(filter 1,$(PNG)),libpng)
+DEP_FALLBACK := $(if $(filter 1,$(HDF5)),-lhdf5) $(if $(filter 1,$(PNG)),-lpng)
+DEPS_CFLAGS := $(if $(strip $(DEP_PKGS)),$(shell pkg-config --cflags $(DEP_PKGS) 2>/dev/null)) \
+               $(if $(filter 0,$(HDF5)),-DDEM_NO_HDF5) $(if $(filter 0,$(PNG)),-DDEM_NO_PNG)
+DEPS_LIBS   := $(if $(strip $(DEP_PKGS)),$(shell pkg-config --libs $(DEP_PKGS) 2>/dev/null || echo $(DEP_FALLBACK)))
 CFLAGS  += -std=c99 -Wall -Wextra -Wpedantic -Werror -fPIC -fopenmp -fvisibility=hidden $(OPT) -Iinclude -Ilibdem $(DEPS_CFLAGS)
 LDLIBS  += $(DEPS_LIBS) -lm
 PYTHON  := .venv/bin/python
@@ -33,7 +39,7 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib pydem setup test test-c test-sanitize test-py bench bench-screening demo install clean FORCE
+.PHONY: all lib pydem setup test test-c test-sanitize test-minimal test-py bench bench-screening demo install clean FORCE
 
 all: lib
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
@@ -73,7 +79,15 @@ $(BUILD)/tests/%: tests/c/%.c $(wildcard tests/c/*.h) $(BUILD)/libdem.a
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)
 
 test: setup
-	@$(MAKE) --no-print-directory test-c test-sanitize test-py
+	@$(MAKE) --no-print-directory test-c test-sanitize test-minimal test-py
+
+# libdem without HDF5 and libpng (HDF5=0 PNG=0), linked without them
+test-minimal:
+	@echo "== libdem built and linked without HDF5 and libpng"
+	@$(MAKE) --no-print-directory -s BUILD=$(BUILD)/minimal HDF5=0 PNG=0 OPT=-O1 $(BUILD)/minimal/libdem.a
+	@$(CC) -std=c99 -Wall -Wextra -Werror -fopenmp -Iinclude tests/c/minimal/test_minimal_build.c -o $(BUILD)/minimal/test_minimal_build \
+	  $(BUILD)/minimal/libdem.a -lcmocka -lm
+	@cd $(BUILD)/minimal && ./test_minimal_build
 
 # every C test again under AddressSanitizer + UndefinedBehaviorSanitizer (+ leak check)
 SAN_OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all

@@ -3,7 +3,9 @@
 #include "internal.h"
 #include <float.h>
 #include <math.h>
+#ifndef DEM_NO_PNG
 #include <png.h>
+#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -186,6 +188,7 @@ dem_status dem_render_rgb(dem_domain *d, const dem_render_def *def, unsigned cha
     return DEM_OK;
 }
 
+#ifndef DEM_NO_PNG
 /* 1 on success; libpng reports its errors by longjmp, so nothing here changes after setjmp. */
 static int write_png(FILE *fp, const unsigned char *rgb, int w, int h)
 {
@@ -215,9 +218,17 @@ static int write_png(FILE *fp, const unsigned char *rgb, int w, int h)
     return 1;
 }
 
+#endif
+
 dem_status dem_render_png(dem_domain *d, const dem_render_def *def, const char *path)
 {
     if (!d) return DEM_ERR_NULL;
+#ifdef DEM_NO_PNG /* a build without libpng (make PNG=0) */
+    (void)def;
+    (void)path;
+    return dem_fail(d, DEM_ERR_UNSUPPORTED,
+                    "dem_render_png: this libdem was built without libpng (make PNG=0); dem_render_rgb gives the pixels");
+#else
     if (!def || !path) return dem_fail(d, DEM_ERR_NULL, "dem_render_png: def and path must not be NULL");
     if (def->width < 1 || def->height < 1 || def->width > 16384 || def->height > 16384)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_render_png: image size must be 1..16384 pixels, got %d x %d",
@@ -240,4 +251,5 @@ dem_status dem_render_png(dem_domain *d, const dem_render_def *def, const char *
     if (!ok) return dem_fail(d, DEM_ERR_IO, "dem_render_png: writing '%s' failed", path);
     dem_clear_error(d);
     return DEM_OK;
+#endif
 }

@@ -6,7 +6,7 @@
  * particles and of moving meshes); the reader rebuilds the list from them — the same list,
  * the same order — then puts back the current state, the forces of the last step (the next
  * step's first half kick uses them) and every contact history. */
-#include "snapshot_h5.h"
+#include "internal.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,6 +18,16 @@ dem_status dem_domain_set_seed(dem_domain *d, uint64_t seed)
 }
 
 uint64_t dem_domain_seed(const dem_domain *d) { return d ? d->seed : 0; }
+
+#ifdef DEM_NO_HDF5 /* a build without HDF5 (make HDF5=0): snapshots are not available */
+dem_status dem_snapshot_write(dem_domain *d, const char *path)
+{
+    (void)path;
+    if (!d) return DEM_ERR_NULL;
+    return dem_fail(d, DEM_ERR_UNSUPPORTED, "dem_snapshot_write: this libdem was built without HDF5 (make HDF5=0)");
+}
+#else
+#include "snapshot_h5.h"
 
 /* ---- small HDF5 helpers: 0 on failure --------------------------------------------- */
 static int w_dset(hid_t loc, const char *name, hid_t type, hsize_t rows, hsize_t cols, const void *data)
@@ -311,3 +321,4 @@ dem_status dem_snapshot_write(dem_domain *d, const char *path)
     dem_clear_error(d);
     return DEM_OK;
 }
+#endif /* DEM_NO_HDF5 */

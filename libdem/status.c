@@ -23,6 +23,7 @@ const char *dem_status_name(dem_status s)
     case DEM_ERR_UNKNOWN_WALL: return "DEM_ERR_UNKNOWN_WALL";
     case DEM_ERR_IO: return "DEM_ERR_IO";
     case DEM_ERR_FORMAT: return "DEM_ERR_FORMAT";
+    case DEM_ERR_UNSUPPORTED: return "DEM_ERR_UNSUPPORTED";
     }
     return "DEM_UNKNOWN_STATUS";
 }

@@ -44,7 +44,8 @@ typedef enum dem_status {
     DEM_ERR_UNKNOWN_EFFECT = -11,
     DEM_ERR_UNKNOWN_WALL = -12,
     DEM_ERR_IO = -13,
-    DEM_ERR_FORMAT = -14
+    DEM_ERR_FORMAT = -14,
+    DEM_ERR_UNSUPPORTED = -15      /* a feature this build left out (make HDF5=0 or PNG=0) */
 } dem_status;
 
 /* Short fixed name of a status ("DEM_ERR_OVERLAP"); never NULL. */
