@@ -55,11 +55,12 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--vtk", help="directory for a VTK time series at the frame times (ParaView: open particles.pvd)")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
-    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose
+    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_locus
     cli_campaign.add_parser(sub)
     cli_compare.add_parser(sub)
     cli_diagnose.add_parser(sub)
     cli_calibrate.add_parser(sub)
+    cli_locus.add_parser(sub)
     return ap
 
 

@@ -65,3 +65,71 @@ def evaluate(sigma_pre: float, tau_pre: float, sigma, tau) -> LocusResult:
     sigma_1 = p + r
     return LocusResult(math.degrees(phi), c, sigma_c, sigma_1, sigma_1 / sigma_c if sigma_c > 0 else math.inf,
                        math.degrees(math.asin(min(r / p, 1.0))), math.degrees(math.atan2(tau_pre, sigma_pre)), p, r)
+
+
+@dataclass
+class Locus:
+    """One yield locus as measured: the pre-shear point and the shear points."""
+    label: str
+    sigma_pre: float
+    tau_pre: float
+    sigma: list
+    tau: list
+
+    @classmethod
+    def from_result(cls, data: dict, label: str = "") -> "Locus":
+        """From a ring-shear rig result (RigResult.to_dict() or its JSON file)."""
+        if data.get("rig") != "ring-shear":
+            raise ValueError(f"{label or 'result'}: a ring-shear result is needed, got rig {data.get('rig')!r}")
+        m, pts = data["metrics"], data.get("info", {}).get("shear_points", [])
+        if len({p["fraction"] for p in pts}) < 2:
+            raise ValueError(f"{label or 'result'}: a yield locus needs shear points at two or more fractions "
+                             f"(run with --set shear_points=[0.4,0.6,0.8])")
+        return cls(label, float(m["sigma_preshear"]["value"]), float(m["tau_preshear"]["value"]),
+                   [p["sigma"] for p in pts], [p["tau_peak"] for p in pts])
+
+    def evaluate(self) -> LocusResult:
+        return evaluate(self.sigma_pre, self.tau_pre, self.sigma, self.tau)
+
+
+def plot_loci(loci: list[Locus], path) -> None:
+    """Left: each locus — shear points, pre-shear point, the linearised locus, the consolidation
+    Mohr circle (sigma_1) and the unconfined-yield circle (sigma_c). Right: the flow function
+    sigma_c(sigma_1) with Jenike's ffc = 1, 2, 4, 10 lines."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, af) = plt.subplots(1, 2, figsize=(11, 4.6), layout="constrained")
+    t = np.linspace(0.0, np.pi, 200)
+    s1s, scs = [], []
+    for k, lc in enumerate(loci):
+        r = lc.evaluate()
+        col = f"C{k}"
+        ax.plot(lc.sigma, lc.tau, "o", color=col, label=f"{lc.label}: shear points")
+        ax.plot([lc.sigma_pre], [lc.tau_pre], "s", color=col, mfc="none", ms=8, label=f"{lc.label}: pre-shear")
+        x = np.linspace(0.0, r.sigma_1, 50)
+        ax.plot(x, r.cohesion + x * math.tan(math.radians(r.phi_lin)), "-", color=col, lw=1)
+        ax.plot(r.centre + r.radius * np.cos(t), r.radius * np.sin(t), "--", color=col, lw=1)
+        if r.sigma_c > 0:
+            ax.plot(0.5 * r.sigma_c * (1 + np.cos(t)), 0.5 * r.sigma_c * np.sin(t), ":", color=col, lw=1)
+        s1s.append(r.sigma_1)
+        scs.append(r.sigma_c)
+    ax.set_xlabel("normal stress sigma (Pa)")
+    ax.set_ylabel("shear stress tau (Pa)")
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=6)
+    ax.set_title("yield loci with Mohr circles (dashed: sigma_1, dotted: sigma_c)", fontsize=9)
+    top = max(s1s) * 1.1
+    for ffc in (1, 2, 4, 10):
+        af.plot([0, top], [0, top / ffc], color="0.7", lw=0.8)
+        af.text(top, top / ffc, f"ffc = {ffc}", fontsize=7, color="0.4", va="center")
+    af.plot(s1s, scs, "o-", color="k")
+    af.set_xlabel("major consolidation stress sigma_1 (Pa)")
+    af.set_ylabel("unconfined yield strength sigma_c (Pa)")
+    af.set_xlim(0, top * 1.15)
+    af.set_ylim(bottom=0.0)
+    af.set_title("flow function", fontsize=9)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -75,3 +75,37 @@ def test_ring_shear_metric_functions_by_hand():
     one = {}
     locus_metrics(2000.0, 1000.0, [(0.5, 1000.0, 600.0)], one, {})
     assert one == {}  # one fraction: no locus
+
+
+def hand_result(c, phi_deg, sigma_pre, tau_pre, sigmas):
+    """A ring-shear result file's content whose shear points lie on tau = c + sigma tan(phi)."""
+    t = math.tan(math.radians(phi_deg))
+    return {"rig": "ring-shear", "metrics": {"sigma_preshear": {"value": sigma_pre}, "tau_preshear": {"value": tau_pre}},
+            "info": {"shear_points": [{"fraction": s / sigma_pre, "sigma": s, "tau_peak": c + s * t} for s in sigmas]}}
+
+
+def test_pydem_locus_reports_and_plots_several_loci(tmp_path):
+    """Two consolidation stresses: the hand-worked locus of this file's docstring, and one with
+    c = 800 Pa, phi 30 deg pre-sheared on its tangent circle at sigma_pre = 4000 Pa."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+    from pydem.rigs.yield_locus import consolidation_circle
+    p, r = consolidation_circle(4000.0, 0.0, math.tan(math.radians(30)), 800.0)  # tangent circle's size
+    tau_pre2 = math.sqrt(r * r - (4000.0 - p) ** 2)
+    (tmp_path / "a.json").write_text(json.dumps(hand_result(500, 30, 2000.0, 1654.26, [800, 1200, 1600])))
+    (tmp_path / "b.json").write_text(json.dumps(hand_result(800, 30, 4000.0, tau_pre2, [1600, 2400, 3200])))
+    root = Path(__file__).resolve().parents[2]
+    out = subprocess.run([sys.executable, "-m", "pydem", "locus", str(tmp_path / "a.json"), str(tmp_path / "b.json"),
+                          "--plot", str(tmp_path / "loci.png")], cwd=root, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    rows = {line.split("|")[1].strip(): [x.strip() for x in line.split("|")[2:-1]] for line in out.stdout.splitlines()
+            if line.startswith("| a ") or line.startswith("| b ")}
+    assert float(rows["a"][1]) == pytest.approx(4933.01, abs=1.5) and rows["a"][2:4] == ["1732", "2.85"]  # by hand
+    assert rows["a"][4] == "40.1" and rows["a"][5] == "30.0" and rows["a"][7] == "500"
+    assert float(rows["b"][2]) == pytest.approx(2 * 800 * math.cos(math.radians(30)) / 0.5, abs=1)  # sigma_c
+    assert (tmp_path / "loci.png").stat().st_size > 20_000
+    bad = subprocess.run([sys.executable, "-m", "pydem", "locus", str(tmp_path / "loci.png")], cwd=root,
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "loci.png: not a ring-shear result file" in bad.stderr
