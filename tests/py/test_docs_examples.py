@@ -48,7 +48,7 @@ def test_documented_command(argv, tmp_path):
     if cmd == "rig":
         rest, skip = [], False
         for a in argv[2:]:  # without the output flags and their values: --list only validates
-            if skip or a in ("--out", "--frames"):
+            if skip or a in ("--out", "--frames", "--vtk"):
                 skip = not skip
                 continue
             rest.append(a)
