@@ -47,7 +47,7 @@ def main() -> int:
     out = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.json"
     out.parent.mkdir(exist_ok=True)
     meta = {"date": time.strftime("%Y-%m-%d"), "machine": f"{platform.machine()}, {len(__import__('os').sched_getaffinity(0))} cores",
-            "seconds": time.perf_counter() - t0, "stores": [str(s.relative_to(ROOT)) for s in stores if s.exists()],
+            "seconds": time.perf_counter() - t0, "stores": [str(s.relative_to(ROOT)) if s.is_relative_to(ROOT) else str(s) for s in stores if s.exists()],
             "nets": {q.key: {"r2": n.r2, "rmse": n.rmse, "scatter": n.scatter, "runs": n.runs} for q, n in setup.nets.items()},
             "command": " ".join(sys.argv)}
     out.write_text(json.dumps({"meta": meta, "scores": scores, "sets": rows}, indent=1, default=float))

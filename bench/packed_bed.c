@@ -202,11 +202,11 @@ int main(int argc, char **argv)
     if (save) {
         double *buf = malloc(sizeof(double) * 3 * n);
         FILE *f = fopen(save, "wb");
-        dem_particles_get_positions(d, buf);
+        dem_particles_get_positions(d, buf, dem_particle_count(d));
         fwrite(buf, sizeof(double), (size_t)(3 * n), f);
-        dem_particles_get_velocities(d, buf);
+        dem_particles_get_velocities(d, buf, dem_particle_count(d));
         fwrite(buf, sizeof(double), (size_t)(3 * n), f);
-        dem_particles_get_angular_velocities(d, buf);
+        dem_particles_get_angular_velocities(d, buf, dem_particle_count(d));
         fwrite(buf, sizeof(double), (size_t)(3 * n), f);
         fclose(f);
         free(buf);

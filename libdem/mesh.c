@@ -475,18 +475,29 @@ dem_status dem_mesh_wall_info(const dem_domain *d, int k, dem_mesh_info *info)
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_vertices(const dem_domain *d, int k, double *vertices)
+/* Room for the mesh's `count` vertices or triangles in a caller's buffer? */
+static dem_status mesh_room(const dem_domain *d, int64_t capacity, int64_t count, const char *fn)
+{
+    if (capacity < count)
+        return dem_fail((dem_domain *)d, DEM_ERR_INVALID_ARGUMENT, "%s: room for %lld, the mesh has %lld", fn,
+                        (long long)capacity, (long long)count);
+    return DEM_OK;
+}
+
+dem_status dem_mesh_wall_get_vertices(const dem_domain *d, int k, double *vertices, int64_t capacity)
 {
     if (!d || !vertices) return DEM_ERR_NULL;
     if (k < 0 || k >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
+    if (mesh_room(d, capacity, d->meshes[k].nv, "dem_mesh_wall_get_vertices") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;
     memcpy(vertices, d->meshes[k].x, (size_t)d->meshes[k].nv * 3 * sizeof(double));
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_triangles(const dem_domain *d, int k, int32_t *triangles)
+dem_status dem_mesh_wall_get_triangles(const dem_domain *d, int k, int32_t *triangles, int64_t capacity)
 {
     if (!d || !triangles) return DEM_ERR_NULL;
     if (k < 0 || k >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
+    if (mesh_room(d, capacity, d->meshes[k].nt, "dem_mesh_wall_get_triangles") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;
     memcpy(triangles, d->meshes[k].tri, (size_t)d->meshes[k].nt * 3 * sizeof(int32_t));
     return DEM_OK;
 }
@@ -522,10 +533,11 @@ dem_status dem_mesh_wall_force(const dem_domain *d, int mesh, const double point
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_triangle_forces(const dem_domain *d, int mesh, double *forces)
+dem_status dem_mesh_wall_triangle_forces(const dem_domain *d, int mesh, double *forces, int64_t capacity)
 {
     if (!d || !forces) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
+    if (mesh_room(d, capacity, d->meshes[mesh].nt, "dem_mesh_wall_triangle_forces") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;
     memset(forces, 0, (size_t)d->meshes[mesh].nt * 3 * sizeof(double));
     const tri_list *tl = &d->tris_cur;
     for (int64_t k = 0; k < tl->count; k++)

@@ -263,10 +263,23 @@ dem_status dem_particles_remove(dem_domain *d, int64_t n, const dem_particle_id 
 
 int64_t dem_particle_count(const dem_domain *d) { return d ? d->n : 0; }
 
+/* A read-back buffer with room for `capacity` particles: enough for all of them? (The error
+ * message is the one field of a const domain that a getter writes.) */
+static dem_status room_for(const dem_domain *d, int64_t capacity, const char *fn)
+{
+    if (capacity < d->n)
+        return dem_fail((dem_domain *)d, DEM_ERR_INVALID_ARGUMENT, "%s: room for %lld particles, the domain has %lld", fn,
+                        (long long)capacity, (long long)d->n);
+    return DEM_OK;
+}
+
 /* Copy `width` doubles per particle from src into out, ascending id order. */
-static dem_status read_back(const dem_domain *d, const double *src, int width, double *out)
+static dem_status read_back(const dem_domain *d, const double *src, int width, double *out, int64_t capacity,
+                            const char *fn)
 {
     if (!d || !out) return DEM_ERR_NULL;
+    dem_status s = room_for(d, capacity, fn);
+    if (s != DEM_OK) return s;
     int64_t q = 0;
     for (dem_particle_id id = 0; id < d->next_id; id++) {
         int32_t i = d->index_of_id[id];
@@ -277,24 +290,29 @@ static dem_status read_back(const dem_domain *d, const double *src, int width, d
     return DEM_OK;
 }
 
-dem_status dem_particles_get_ids(const dem_domain *d, dem_particle_id *ids)
+dem_status dem_particles_get_ids(const dem_domain *d, dem_particle_id *ids, int64_t capacity)
 {
     if (!d || !ids) return DEM_ERR_NULL;
+    dem_status s = room_for(d, capacity, "dem_particles_get_ids");
+    if (s != DEM_OK) return s;
     int64_t q = 0;
     for (dem_particle_id id = 0; id < d->next_id; id++)
         if (d->index_of_id[id] >= 0) ids[q++] = id;
     return DEM_OK;
 }
 
-dem_status dem_particles_get_positions(const dem_domain *d, double *p) { return read_back(d, d ? d->x : NULL, 3, p); }
-dem_status dem_particles_get_velocities(const dem_domain *d, double *p) { return read_back(d, d ? d->v : NULL, 3, p); }
-dem_status dem_particles_get_angular_velocities(const dem_domain *d, double *p)
-{
-    return read_back(d, d ? d->w : NULL, 3, p);
-}
-dem_status dem_particles_get_forces(const dem_domain *d, double *p) { return read_back(d, d ? d->f : NULL, 3, p); }
-dem_status dem_particles_get_torques(const dem_domain *d, double *p) { return read_back(d, d ? d->t : NULL, 3, p); }
-dem_status dem_particles_get_radii(const dem_domain *d, double *p) { return read_back(d, d ? d->radius : NULL, 1, p); }
+#define GETTER(name, field, width)                                                        \
+    dem_status dem_particles_get_##name(const dem_domain *d, double *p, int64_t capacity) \
+    {                                                                                     \
+        return read_back(d, d ? d->field : NULL, width, p, capacity, "dem_particles_get_" #name); \
+    }
+GETTER(positions, x, 3)
+GETTER(velocities, v, 3)
+GETTER(angular_velocities, w, 3)
+GETTER(forces, f, 3)
+GETTER(torques, t, 3)
+GETTER(radii, radius, 1)
+#undef GETTER
 
 static dem_status write_vec3(dem_domain *d, double *dst, const double *src, const char *fn)
 {

@@ -102,7 +102,7 @@ dem_status dem_vtk_write_mesh(dem_domain *d, int mesh, const char *path)
     const int64_t nv = d->meshes[mesh].nv, nt = d->meshes[mesh].nt;
     double *force = malloc((size_t)(nt > 0 ? nt : 1) * 3 * sizeof(double));
     if (!force) return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_vtk_write_mesh: out of memory");
-    dem_mesh_wall_triangle_forces(d, mesh, force);
+    dem_mesh_wall_triangle_forces(d, mesh, force, nt);
     FILE *fp = open_vtu(d, path, "dem_vtk_write_mesh", nv, nt);
     if (!fp) {
         free(force);

@@ -229,7 +229,7 @@ class Domain:
         n = len(self)
         out = np.empty((n, width) if width else (n,), dtype=dtype)
         if n:
-            self._check(fn(self._d, _ptr(out, "int64_t[]" if dtype == np.int64 else "double[]")))
+            self._check(fn(self._d, _ptr(out, "int64_t[]" if dtype == np.int64 else "double[]"), n))
         return out
 
     @property

@@ -71,13 +71,13 @@ class MeshWall:
     @property
     def vertices(self) -> np.ndarray:
         out = np.empty((self.info()["vertex_count"], 3))
-        self.domain._check(lib.dem_mesh_wall_get_vertices(self.domain._d, self.index, _ptr(out, "double[]")))
+        self.domain._check(lib.dem_mesh_wall_get_vertices(self.domain._d, self.index, _ptr(out, "double[]"), len(out)))
         return out
 
     @property
     def triangles(self) -> np.ndarray:
         out = np.empty((self.info()["triangle_count"], 3), dtype=np.int32)
-        self.domain._check(lib.dem_mesh_wall_get_triangles(self.domain._d, self.index, _ptr(out, "int32_t[]")))
+        self.domain._check(lib.dem_mesh_wall_get_triangles(self.domain._d, self.index, _ptr(out, "int32_t[]"), len(out)))
         return out
 
     def set_motion(self, velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] | None = None,
@@ -135,7 +135,7 @@ class MeshWall:
 
     def triangle_forces(self) -> np.ndarray:
         out = np.empty((self.info()["triangle_count"], 3))
-        self.domain._check(lib.dem_mesh_wall_triangle_forces(self.domain._d, self.index, _ptr(out, "double[]")))
+        self.domain._check(lib.dem_mesh_wall_triangle_forces(self.domain._d, self.index, _ptr(out, "double[]"), len(out)))
         return out
 
     def stress(self, normal: Sequence[float], area: float) -> tuple[float, float]:

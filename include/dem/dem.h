@@ -82,15 +82,17 @@ DEM_API dem_status dem_particles_add(dem_domain *domain, int64_t n, const double
                                      const double *angular_velocity, dem_particle_id *ids);
 DEM_API dem_status dem_particles_remove(dem_domain *domain, int64_t n, const dem_particle_id *ids);
 DEM_API int64_t dem_particle_count(const dem_domain *domain);
-/* Read-back into caller buffers of at least dem_particle_count() entries (x3 for vectors),
- * in ascending id order. Forces and torques are the contact (+ wall) parts of the last step. */
-DEM_API dem_status dem_particles_get_ids(const dem_domain *domain, dem_particle_id *ids);
-DEM_API dem_status dem_particles_get_positions(const dem_domain *domain, double *position);
-DEM_API dem_status dem_particles_get_velocities(const dem_domain *domain, double *velocity);
-DEM_API dem_status dem_particles_get_angular_velocities(const dem_domain *domain, double *angular_velocity);
-DEM_API dem_status dem_particles_get_forces(const dem_domain *domain, double *force);
-DEM_API dem_status dem_particles_get_torques(const dem_domain *domain, double *torque);
-DEM_API dem_status dem_particles_get_radii(const dem_domain *domain, double *radius);
+/* Read-back, in ascending id order, into caller buffers with room for `capacity` particles
+ * (x3 doubles for vectors): DEM_ERR_INVALID_ARGUMENT, nothing written, when capacity <
+ * dem_particle_count(). Forces and torques are the contact (+ wall) parts of the last step. */
+DEM_API dem_status dem_particles_get_ids(const dem_domain *domain, dem_particle_id *ids, int64_t capacity);
+DEM_API dem_status dem_particles_get_positions(const dem_domain *domain, double *position, int64_t capacity);
+DEM_API dem_status dem_particles_get_velocities(const dem_domain *domain, double *velocity, int64_t capacity);
+DEM_API dem_status dem_particles_get_angular_velocities(const dem_domain *domain, double *angular_velocity,
+                                                        int64_t capacity);
+DEM_API dem_status dem_particles_get_forces(const dem_domain *domain, double *force, int64_t capacity);
+DEM_API dem_status dem_particles_get_torques(const dem_domain *domain, double *torque, int64_t capacity);
+DEM_API dem_status dem_particles_get_radii(const dem_domain *domain, double *radius, int64_t capacity);
 /* Overwrite velocities / angular velocities (ascending id order, count entries x 3). */
 DEM_API dem_status dem_particles_set_velocities(dem_domain *domain, const double *velocity);
 DEM_API dem_status dem_particles_set_angular_velocities(dem_domain *domain, const double *angular_velocity);

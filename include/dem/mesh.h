@@ -64,9 +64,11 @@ DEM_API dem_status dem_mesh_wall_add(dem_domain *domain, int64_t n_vertices, con
                                      int *mesh);
 DEM_API int dem_mesh_wall_count(const dem_domain *domain);
 DEM_API dem_status dem_mesh_wall_info(const dem_domain *domain, int mesh, dem_mesh_info *info);
-/* Current (moved) vertices, 3 x vertex_count, and triangles, 3 x triangle_count. */
-DEM_API dem_status dem_mesh_wall_get_vertices(const dem_domain *domain, int mesh, double *vertices);
-DEM_API dem_status dem_mesh_wall_get_triangles(const dem_domain *domain, int mesh, int32_t *triangles);
+/* Current (moved) vertices, 3 x vertex_count, and triangles, 3 x triangle_count, into buffers
+ * with room for `capacity` vertices / triangles (DEM_ERR_INVALID_ARGUMENT when too small). */
+DEM_API dem_status dem_mesh_wall_get_vertices(const dem_domain *domain, int mesh, double *vertices, int64_t capacity);
+DEM_API dem_status dem_mesh_wall_get_triangles(const dem_domain *domain, int mesh, int32_t *triangles,
+                                               int64_t capacity);
 
 /* Prescribed rigid motion from now on: translation velocity (m/s) plus rotation at
  * angular_velocity (rad/s, vector along the axis) about an axis through `centre` (m, a point
@@ -94,8 +96,8 @@ DEM_API dem_status dem_mesh_wall_force(const dem_domain *domain, int mesh, const
 DEM_API dem_status dem_mesh_wall_reset_mean_force(dem_domain *domain, int mesh);
 DEM_API dem_status dem_mesh_wall_mean_force(const dem_domain *domain, int mesh, const double point[3],
                                             double force[3], double torque[3], double *seconds);
-/* Force on each triangle, 3 x triangle_count (N). */
-DEM_API dem_status dem_mesh_wall_triangle_forces(const dem_domain *domain, int mesh, double *forces);
+/* Force on each triangle, 3 x triangle_count (N), into a buffer with room for `capacity` triangles. */
+DEM_API dem_status dem_mesh_wall_triangle_forces(const dem_domain *domain, int mesh, double *forces, int64_t capacity);
 /* Normal and shear stress of the wall force over `area` (m^2) for the unit `normal`:
  * sigma_n = F.n / A, tau = |F - (F.n) n| / A (Pa). */
 DEM_API dem_status dem_mesh_wall_stress(const dem_domain *domain, int mesh, const double normal[3], double area,

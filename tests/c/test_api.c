@@ -136,7 +136,7 @@ static void test_misuse_leaves_domain_usable(void **st)
     assert_ok(dem_particles_remove(d, 1, &ids[0]));
     assert_int_equal(dem_particle_count(d), 1);
     dem_particle_id left;
-    assert_ok(dem_particles_get_ids(d, &left));
+    assert_ok(dem_particles_get_ids(d, &left, dem_particle_count(d)));
     assert_int_equal(left, ids[1]);
     assert_ok(dem_domain_step(d, 100));
     dem_domain_destroy(d);
@@ -225,10 +225,10 @@ static void test_lifecycle_edges(void **st)
     assert_ok(dem_domain_step(d, 10));
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, more)); /* ids are never reused */
     assert_true(more[0] == ids[1] + 1 && more[1] == ids[1] + 2);
-    assert_status(dem_particles_get_positions(d, NULL), DEM_ERR_NULL);
+    assert_status(dem_particles_get_positions(d, NULL, dem_particle_count(d)), DEM_ERR_NULL);
     double bad_v[6] = {0, 0, 0, NAN, 0, 0};
     assert_status(dem_particles_set_velocities(d, bad_v), DEM_ERR_INVALID_ARGUMENT);
-    assert_ok(dem_particles_get_velocities(d, v));
+    assert_ok(dem_particles_get_velocities(d, v, dem_particle_count(d)));
     for (int k = 0; k < 6; k++) assert_true(v[k] == 0.0); /* unchanged */
     dem_particle_id twice[2] = {more[0], more[0]};
     assert_status(dem_particles_remove(d, 2, twice), DEM_ERR_UNKNOWN_PARTICLE);
@@ -257,6 +257,29 @@ static void test_periodic_too_small(void **st)
     dem_domain_destroy(d);
 }
 
+/* Read-back buffers carry their capacity: a short one is refused, untouched, with the counts. */
+static void test_getters_check_capacity(void **st)
+{
+    (void)st;
+    dem_domain_def def = dem_default_domain_def();
+    dem_domain *d;
+    assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
+    dem_material_def m = dem_default_material_def();
+    int mat;
+    assert_ok(dem_material_create(d, &m, &mat));
+    double pos[6] = {0.02, 0.02, 0.02, 0.06, 0.06, 0.06}, rad[2] = {0.005, 0.005}, out[6] = {-1, -1, -1, -1, -1, -1};
+    int mats[2] = {mat, mat};
+    assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, NULL));
+    assert_int_equal(dem_particles_get_positions(d, out, 1), DEM_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(dem_domain_last_error(d), "room for 1 particles, the domain has 2"));
+    for (int k = 0; k < 6; k++) assert_true(out[k] == -1.0); /* nothing written */
+    dem_particle_id ids[2];
+    assert_int_equal(dem_particles_get_ids(d, ids, 0), DEM_ERR_INVALID_ARGUMENT);
+    assert_ok(dem_particles_get_positions(d, out, 2));
+    assert_true(out[3] == 0.06);
+    dem_domain_destroy(d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -267,6 +290,7 @@ int main(void)
         cmocka_unit_test(test_broken_runs_name_the_particle),
         cmocka_unit_test(test_periodic_too_small),
         cmocka_unit_test(test_lifecycle_edges),
+        cmocka_unit_test(test_getters_check_capacity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -83,7 +83,7 @@ static void test_momentum(void **st)
     dem_diagnostics g0, g;
     assert_ok(dem_domain_diagnostics(d, &g0));
     double vel[3 * 216];
-    assert_ok(dem_particles_get_velocities(d, vel));
+    assert_ok(dem_particles_get_velocities(d, vel, dem_particle_count(d)));
     double scale = 0;
     for (int k = 0; k < 3 * 216; k++) scale += sphere_mass(2500, R) * fabs(vel[k]);
     assert_ok(dem_domain_step(d, 20000));

@@ -48,7 +48,7 @@ static double pair_force_z(double kc, double delta)
     int mats[2] = {mat, mat};
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, NULL));
     assert_ok(dem_domain_step(d, 0)); /* forces of the current state */
-    assert_ok(dem_particles_get_forces(d, f));
+    assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
     assert_close(f[5], -f[2], 1e-14, 0); /* action = reaction */
     dem_domain_destroy(d);
     return f[5]; /* on the upper sphere, +z = repulsive */
@@ -84,7 +84,7 @@ static void test_sjkr_wall_and_switch_off(void **st)
     double pos[3] = {0.05, 0.05, R - delta}, rad[1] = {R}, f[3], fw[3];
     assert_ok(dem_particles_add(d, 1, pos, rad, &mat, NULL, NULL, NULL));
     assert_ok(dem_domain_step(d, 0));
-    assert_ok(dem_particles_get_forces(d, f));
+    assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
     double hertz = 4.0 / 3.0 * es * sqrt(R * delta) * delta, r = R - delta;
     assert_close(f[2], hertz - KC * M_PI * (R * R - r * r), 1e-12, 0);
     assert_ok(dem_plane_wall_force(d, wall, fw));
@@ -93,7 +93,7 @@ static void test_sjkr_wall_and_switch_off(void **st)
     kc = 0.0;
     assert_ok(dem_pair_set_effect(d, mat, mat, "cohesion_sjkr", &kc, 1));
     assert_ok(dem_domain_step(d, 0));
-    assert_ok(dem_particles_get_forces(d, f));
+    assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
     assert_close(f[2], hertz, 1e-12, 0);
     /* bad input */
     kc = -1;
@@ -143,7 +143,7 @@ static void spin_down(double mu_t, double t_half, double t_end, double *w_half, 
     const int64_t n_half = (int64_t)llround(t_half / def.dt), n_end = (int64_t)llround(t_end / def.dt);
     for (int64_t s = 1; s <= n_end; s++) {
         assert_ok(dem_domain_step(d, 1));
-        assert_ok(dem_particles_get_angular_velocities(d, om));
+        assert_ok(dem_particles_get_angular_velocities(d, om, dem_particle_count(d)));
         if (om[2] < *w_min) *w_min = om[2];
         if (s == n_half) *w_half = om[2];
     }

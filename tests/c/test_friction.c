@@ -73,9 +73,9 @@ static void floor_impact(double e, const double v[3], const double w[3], double 
     for (int s = 0; s < im.steps; s++) {
         assert_ok(dem_domain_step(im.d, 1));
         double f[3];
-        assert_ok(dem_particles_get_forces(im.d, f));
-        assert_ok(dem_particles_get_velocities(im.d, vel));
-        assert_ok(dem_particles_get_angular_velocities(im.d, om));
+        assert_ok(dem_particles_get_forces(im.d, f, dem_particle_count(im.d)));
+        assert_ok(dem_particles_get_velocities(im.d, vel, dem_particle_count(im.d)));
+        assert_ok(dem_particles_get_angular_velocities(im.d, om, dem_particle_count(im.d)));
         if (f[2] == 0.0) continue;
         in_contact++;
         /* slip of the contact point (at -R z from the centre): v + w x (-R z), tangential part */
@@ -149,10 +149,10 @@ static void test_oblique_pair_impact_gross_sliding(void **st)
         double om[6], x[6], f[6];
         for (int s = 0; s < im.steps; s++) { /* friction never along the slip, as on the floor */
             assert_ok(dem_domain_step(im.d, 1));
-            assert_ok(dem_particles_get_forces(im.d, f));
-            assert_ok(dem_particles_get_positions(im.d, x));
-            assert_ok(dem_particles_get_velocities(im.d, vel));
-            assert_ok(dem_particles_get_angular_velocities(im.d, om));
+            assert_ok(dem_particles_get_forces(im.d, f, dem_particle_count(im.d)));
+            assert_ok(dem_particles_get_positions(im.d, x, dem_particle_count(im.d)));
+            assert_ok(dem_particles_get_velocities(im.d, vel, dem_particle_count(im.d)));
+            assert_ok(dem_particles_get_angular_velocities(im.d, om, dem_particle_count(im.d)));
             double n[3], dist = 0.0; /* from sphere 0 to sphere 1 */
             for (int a = 0; a < 3; a++) dist += (x[3 + a] - x[a]) * (x[3 + a] - x[a]);
             for (int a = 0; a < 3; a++) n[a] = (x[3 + a] - x[a]) / sqrt(dist);

@@ -20,8 +20,8 @@ static impact run_impact(dem_domain *d, int wall, double dt)
     long steps = 0;
     for (long s = 0; s < 2000000 && !ended; s++) {
         assert_ok(dem_domain_step(d, 1));
-        assert_ok(dem_particles_get_positions(d, x));
-        assert_ok(dem_particles_get_forces(d, f));
+        assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+        assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
         double overlap = wall ? R - x[2] : 2 * R - fabs(x[5] - x[2]);
         double fz = fabs(f[2]);
         if (overlap > 0) {

@@ -33,7 +33,7 @@ static drop run_drop(int mesh_n, double x, double y, double e, double mu)
         assert_ok(dem_domain_step(d, 1));
         double f[3], v3[3];
         dem_diagnostics dg;
-        assert_ok(dem_particles_get_forces(d, f));
+        assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
         assert_ok(dem_domain_diagnostics(d, &dg));
         if (dg.wall_contact_count > r.max_contacts) r.max_contacts = (int)dg.wall_contact_count;
         if (dg.wall_contact_count > 0) {
@@ -41,7 +41,7 @@ static drop run_drop(int mesh_n, double x, double y, double e, double mu)
             r.contact_time += 2e-7;
             if (f[2] > r.peak_force) r.peak_force = f[2];
         } else if (touching) {
-            assert_ok(dem_particles_get_velocities(d, v3));
+            assert_ok(dem_particles_get_velocities(d, v3, dem_particle_count(d)));
             r.rebound = v3[2];
             break;
         }
@@ -100,8 +100,8 @@ static void roll(int mesh, double out[6], int *max_contacts)
         assert_ok(dem_domain_diagnostics(d, &dg));
         if (dg.wall_contact_count > *max_contacts) *max_contacts = (int)dg.wall_contact_count;
     }
-    assert_ok(dem_particles_get_positions(d, out));
-    assert_ok(dem_particles_get_velocities(d, out + 3));
+    assert_ok(dem_particles_get_positions(d, out, dem_particle_count(d)));
+    assert_ok(dem_particles_get_velocities(d, out + 3, dem_particle_count(d)));
     dem_domain_destroy(d);
 }
 
@@ -141,7 +141,7 @@ static void test_moving_mesh_belt(void **state)
     assert_ok(dem_mesh_wall_set_motion(d, m, (double[]){u, 0, 0}, NULL, NULL));
     assert_ok(dem_domain_step(d, 60000)); /* slip ends after 2u/(7 mu g) = 5 ms */
     double vel[3], pose_t[3];
-    assert_ok(dem_particles_get_velocities(d, vel));
+    assert_ok(dem_particles_get_velocities(d, vel, dem_particle_count(d)));
     assert_ok(dem_mesh_wall_get_pose(d, m, pose_t, NULL));
     assert_close(vel[0], 2.0 * u / 7.0, 1e-3, 0);
     assert_close(pose_t[0], u * 60000 * 1e-6, 1e-9, 0); /* the wall moved u t */
@@ -160,14 +160,14 @@ static void test_rotation_pose(void **state)
     assert_ok(dem_mesh_wall_info(d, m, &info));
     const int64_t nv = info.vertex_count;
     double *v = malloc((size_t)nv * 3 * sizeof(double));
-    assert_ok(dem_mesh_wall_get_vertices(d, m, v)); /* before the motion */
+    assert_ok(dem_mesh_wall_get_vertices(d, m, v, nv)); /* before the motion */
     double axis[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)}, w = 2.0, c[3] = {0.02, 0.02, 0.02};
     double om[3] = {w * axis[0], w * axis[1], w * axis[2]};
     assert_ok(dem_mesh_wall_set_motion(d, m, (double[]){0, 0, 0}, om, c));
     assert_ok(dem_domain_step(d, 1000)); /* no particles: the wall still moves */
     double th = w * 1000 * 1e-5, cs = cos(th), sn = sin(th);
     double *x = malloc((size_t)nv * 3 * sizeof(double));
-    assert_ok(dem_mesh_wall_get_vertices(d, m, x));
+    assert_ok(dem_mesh_wall_get_vertices(d, m, x, nv));
     double err = 0.0;
     for (int64_t k = 0; k < nv; k++) {
         double p[3] = {v[3 * k] - c[0], v[3 * k + 1] - c[1], v[3 * k + 2] - c[2]}, kxp[3], kp;
@@ -219,7 +219,7 @@ static void test_mesh_candidates_find_every_contact(void **state)
     for (int chunk = 0; chunk < 180; chunk++) { /* 36,000 steps: the plate rises 18 mm */
         assert_ok(dem_domain_step(d, 200));
         double x[3 * N], t[3];
-        assert_ok(dem_particles_get_positions(d, x));
+        assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
         assert_ok(dem_mesh_wall_get_pose(d, plate, t, NULL));
         int64_t brute = 0;
         for (int k = 0; k < N; k++)

@@ -16,8 +16,8 @@ static int64_t brute_force_contacts(dem_domain *d)
 {
     int64_t n = dem_particle_count(d), count = 0;
     static double x[3 * N], r[N];
-    assert_ok(dem_particles_get_positions(d, x));
-    assert_ok(dem_particles_get_radii(d, r));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+    assert_ok(dem_particles_get_radii(d, r, dem_particle_count(d)));
     for (int64_t i = 0; i < n; i++)
         for (int64_t j = i + 1; j < n; j++) {
             double dx = x[3 * i] - x[3 * j], dy = x[3 * i + 1] - x[3 * j + 1], dz = x[3 * i + 2] - x[3 * j + 2];
@@ -94,13 +94,13 @@ static void test_remove_keeps_state(void **st)
     assert_ok(dem_domain_step(d, 500));
     static double before[3 * N], after[3 * N];
     static dem_particle_id ids[N], left[N];
-    assert_ok(dem_particles_get_ids(d, ids));
-    assert_ok(dem_particles_get_positions(d, before));
+    assert_ok(dem_particles_get_ids(d, ids, dem_particle_count(d)));
+    assert_ok(dem_particles_get_positions(d, before, dem_particle_count(d)));
     dem_particle_id gone[3] = {ids[7], ids[100], ids[399]};
     assert_ok(dem_particles_remove(d, 3, gone));
     assert_int_equal(dem_particle_count(d), N - 3);
-    assert_ok(dem_particles_get_ids(d, left));
-    assert_ok(dem_particles_get_positions(d, after));
+    assert_ok(dem_particles_get_ids(d, left, dem_particle_count(d)));
+    assert_ok(dem_particles_get_positions(d, after, dem_particle_count(d)));
     int q = 0;
     for (int k = 0; k < N; k++) {
         if (ids[k] == gone[0] || ids[k] == gone[1] || ids[k] == gone[2]) continue;
@@ -147,7 +147,7 @@ static void test_lists_shrink_with_the_bed(void **st)
     assert_ok(dem_domain_step(d, 10));
     const size_t full = dem_domain_memory_bytes(d);
     static dem_particle_id ids[M];
-    assert_ok(dem_particles_get_ids(d, ids));
+    assert_ok(dem_particles_get_ids(d, ids, dem_particle_count(d)));
     assert_ok(dem_particles_remove(d, 3 * M / 4, ids)); /* three quarters go: lists fall below 70 % */
     assert_ok(dem_domain_step(d, 50)); /* rebuilt, stepped on the refitted arrays (ASan run) */
     /* the per-entry arrays were refitted to the smaller list: measured 1,050,751 -> 704,049

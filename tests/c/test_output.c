@@ -60,8 +60,8 @@ static dem_domain *rich_run(int *lid)
     /* lid just above the bed: servo-loaded and turning about the vertical axis through the
      * box centre */
     double x[3 * 216], r[216], top = 0.0;
-    assert_ok(dem_particles_get_positions(d, x));
-    assert_ok(dem_particles_get_radii(d, r));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+    assert_ok(dem_particles_get_radii(d, r, dem_particle_count(d)));
     for (int k = 0; k < 216; k++) top = fmax(top, x[3 * k + 2] + r[k]);
     *lid = add_grid_mesh(d, 0.0005, 0.0095, 0.0005, 0.0095, top + 2e-4, 3, 3, mw);
     assert_ok(dem_mesh_wall_set_motion(d, *lid, (double[]){0, 0, 0}, (double[]){0, 0, 3.0}, (double[]){0.005, 0.005, top}));

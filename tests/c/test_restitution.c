@@ -18,10 +18,10 @@ static double rebound(int wall, double e, double v, double dt)
     double x[6], u[6];
     for (int s = 0; s < 100000; s++) {
         assert_ok(dem_domain_step(d, 1));
-        assert_ok(dem_particles_get_positions(d, x));
+        assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
         if (wall ? x[2] > R : x[5] - x[2] > 2 * R) break; /* contact over */
     }
-    assert_ok(dem_particles_get_velocities(d, u));
+    assert_ok(dem_particles_get_velocities(d, u, dem_particle_count(d)));
     dem_domain_destroy(d);
     return wall ? u[2] / v : (u[5] - u[2]) / v;
 }

@@ -49,9 +49,9 @@ static rig make_rig(double mu_r) { return make_rig_model(mu_r, DEM_ROLLING_EPSD2
 
 static void state(dem_domain *d, double *x, double *v, double *w)
 {
-    assert_ok(dem_particles_get_positions(d, x));
-    assert_ok(dem_particles_get_velocities(d, v));
-    assert_ok(dem_particles_get_angular_velocities(d, w));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+    assert_ok(dem_particles_get_velocities(d, v, dem_particle_count(d)));
+    assert_ok(dem_particles_get_angular_velocities(d, w, dem_particle_count(d)));
 }
 
 /* Launch at v0 along x; step until the contact point stops slipping; returns t*. */

@@ -57,7 +57,7 @@ static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_frict
 static double total_weight(dem_domain *d, int64_t n)
 {
     double *r = malloc((size_t)n * sizeof(double)), w = 0.0;
-    assert_ok(dem_particles_get_radii(d, r));
+    assert_ok(dem_particles_get_radii(d, r, dem_particle_count(d)));
     for (int64_t i = 0; i < n; i++) w += 2500.0 * 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i] * 9.81;
     free(r);
     return w;
@@ -89,7 +89,7 @@ static void test_column_weight_on_walls(void **state)
     dem_mesh_info info;
     assert_ok(dem_mesh_wall_info(d, box, &info));
     assert_int_equal(info.triangle_count, 10);
-    assert_ok(dem_mesh_wall_triangle_forces(d, box, tf));
+    assert_ok(dem_mesh_wall_triangle_forces(d, box, tf, (int64_t)(sizeof tf / sizeof tf[0] / 3)));
     assert_ok(dem_mesh_wall_force(d, box, NULL, f, NULL));
     for (int t = 0; t < 10; t++) tot += tf[3 * t + 2];
     assert_close(tot, f[2], 1e-12, 1e-15);
@@ -147,7 +147,7 @@ static void test_servo_lid_and_region_stress(void **state)
     assert_ok(dem_domain_step(d, 30000));
     /* lid: a square over the whole box, just above the highest particle */
     double x[3 * 200], zmax = 0.0;
-    assert_ok(dem_particles_get_positions(d, x));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
     for (int64_t i = 0; i < n; i++) zmax = fmax(zmax, x[3 * i + 2]);
     int lid = add_grid_mesh(d, 0, L, 0, L, zmax + R + 2e-4, 2, 2, mat);
     const double sigma = 2000.0, area = L * L; /* 72 mN, ~30 x the column's weight */
@@ -191,9 +191,9 @@ static void test_servo_lid_and_region_stress(void **state)
     assert_int_equal(st.particle_count, n);
     assert_close(st.total[8], sn, 0.05, 0);
     double rad[200], f[3 * 200], zf = 0.0, mgz = 0.0;
-    assert_ok(dem_particles_get_positions(d, x));
-    assert_ok(dem_particles_get_radii(d, rad));
-    assert_ok(dem_particles_get_forces(d, f));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+    assert_ok(dem_particles_get_radii(d, rad, dem_particle_count(d)));
+    assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
     for (int64_t i = 0; i < n; i++) {
         zf += x[3 * i + 2] * f[3 * i + 2];
         mgz += 2500.0 * 4.0 / 3.0 * M_PI * pow(rad[i], 3) * 9.81 * x[3 * i + 2];
@@ -220,8 +220,8 @@ static void test_single_sphere_closed_form(void **state)
     add_sphere_over_floor(d, mat, 0.005, R, 1e-7, 0.0);
     assert_ok(dem_domain_step(d, 100000));
     double x[3], f[3];
-    assert_ok(dem_particles_get_positions(d, x));
-    assert_ok(dem_particles_get_forces(d, f));
+    assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
+    assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
     double lever = x[2]; /* wall contacts act at the wall surface */
     dem_region box = dem_default_region();
     for (int a = 0; a < 3; a++) {
