@@ -153,19 +153,23 @@ class Frames:
     """Where a rig's frames go at its frame times: PNG images (`frames_dir`) and/or a VTK time
     series for ParaView (`vtk_dir`: particles and mesh walls, pydem.vtk)."""
 
-    def __init__(self, frames_dir: str | Path | None = None, vtk_dir: str | Path | None = None):
+    def __init__(self, frames_dir: str | Path | None = None, vtk_dir: str | Path | None = None, images: bool = False):
         self.dir = Path(frames_dir) if frames_dir else None
         from ..vtk import VtkSeries
         self.vtk = VtkSeries(vtk_dir) if vtk_dir else None
+        self.images = [] if images else None  # centre-cropped grey frames kept in memory (pydem.frames)
 
     @property
     def active(self) -> bool:
-        return self.dir is not None or self.vtk is not None
+        return self.dir is not None or self.vtk is not None or self.images is not None
 
     def write(self, d: Domain, name: str, **render) -> str | None:
         """The PNG's path (None without a frames directory)."""
         if self.vtk is not None:
             self.vtk.write(d)
+        if self.images is not None:
+            from ..frames import crop_grey
+            self.images.append(crop_grey(d.render(**render)))
         if self.dir is None:
             return None
         self.dir.mkdir(parents=True, exist_ok=True)

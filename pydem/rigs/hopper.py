@@ -149,7 +149,7 @@ class Hopper:
 
     # ---- the run ------------------------------------------------------------------------------
     def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
-            vtk_dir: str | Path | None = None) -> RigResult:
+            vtk_dir: str | Path | None = None, images: bool = False) -> RigResult:
         c = self.config
         p = params_from(c.params, params)
         rng = np.random.default_rng(seed)
@@ -184,7 +184,7 @@ class Hopper:
         t0 = d.time
         gate.set_motion(velocity=(0.0, 0.0, -2.0))
         frames, next_frame, last_out = [], [t0], [t0, n_initial]
-        out = Frames(frames_dir, vtk_dir)
+        out = Frames(frames_dir, vtk_dir, images)  # images: seed 001's crop/grey frames in memory
         win = self._window(h_wedge, z_top)
 
         def each():
@@ -219,7 +219,11 @@ class Hopper:
         res.metrics["bulk_density"] = Metric(density[0], density[1], "kg/m^3", "settled bed in the vertical section")
         series["nrrp"] = nr / n_initial
         res.series = series
-        res.frames = self._label_frames(frames, t_dis, out.dir)  # without PNGs (VTK only) there is nothing to label
+        res.frames = self._label_frames(frames, t_dis, out.dir)
+        if images:
+            res.images = np.stack(out.images) if out.images else np.zeros((0, 224, 224), np.uint8)
+            res.series["frame_time"] = np.array([t for _, t, _ in frames])
+            res.series["frame_nrrp"] = np.array([q for _, _, q in frames])  # without PNGs (VTK only) there is nothing to label
         res.info = {"particles": n_initial, "fine": n_fine, "coarse": n_coarse, "case": c.case, "packing": c.packing,
                     "steps": st.steps, "dt": d.dt, "simulated_time": d.time, "emptied": emptied,
                     "engine_profile": d.profile(),

@@ -30,6 +30,7 @@ class RigResult:
     frames: list[str] = field(default_factory=list)
     info: dict = field(default_factory=dict)  # particle count, steps, wall time, settings
     provenance: dict = field(default_factory=dict)  # config, parameters, seed, versions (set by the caller)
+    images: np.ndarray | None = None  # frames kept in memory (hopper, images=True): (n, 224, 224) uint8, not saved
 
     def summary(self) -> str:
         lines = [f"{self.rig}: {self.info.get('particles', '?')} particles, {self.info.get('steps', '?')} steps, "

@@ -1,0 +1,104 @@
+"""Seed 001's data and its grey relational analysis: the 25 Table 1 hopper cases run at their
+full particle counts, every frame centre-cropped and greyed into one HDF5 frame store
+(pydem.frames), each labelled with its time, remaining discharge time and NRRP; then the GRA of
+the 11 Table 1 parameters against the cases' discharge times (nn.gra), per packing and overall.
+
+    .venv/bin/python -m nn.seed001 frames --store data/seed001/frames.h5 [--cases A-1 B1-3] [--frame-interval 0.02]
+    .venv/bin/python -m nn.seed001 gra --store data/seed001/frames.h5
+
+The frame campaign is resumable: a case is written whole when its run ends, and a rerun does
+only the cases the store lacks."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+
+from .gra import grey_relational
+
+# the 11 Table 1 parameters, in the seed's order, and how to read each from a TABLE1 row
+PARAMETERS = ("mu_pp", "mu_pw", "e_pp", "e_pw", "mu_r", "density", "diameter", "youngs_modulus", "poisson_ratio",
+              "particles", "fine_fraction")
+
+
+def parameter_row(case: str) -> dict[str, float]:
+    """The case's 11 parameters; the diameter is the volume-weighted mean of its two sizes (the
+    seed lists one d per case: its fine/coarse pair weighted by the fine volume fraction)."""
+    from pydem.rigs.hopper import TABLE1
+    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[case]
+    return {"mu_pp": mupp, "mu_pw": muwp, "e_pp": epp, "e_pw": ewp, "mu_r": mur, "density": float(rho),
+            "diameter": phi * dd[0] + (1.0 - phi) * dd[1], "youngs_modulus": e_gpa * 1e9, "poisson_ratio": nu,
+            "particles": float(n), "fine_fraction": phi}
+
+
+def gra_tables(discharge: dict[str, float], rho: float = 0.5) -> dict[str, dict[str, float]]:
+    """{group: {parameter: weight %}} for each packing (its cases in Table 1 order) and "all"."""
+    from pydem.rigs.hopper import TABLE1
+    groups = {p: [c for c in TABLE1 if c.split("-")[0] == p and c in discharge] for p in ("A", "B1", "B2", "B3", "B4")}
+    groups["all"] = [c for c in TABLE1 if c in discharge]
+    out = {}
+    for name, cases in groups.items():
+        if len(cases) < 2:
+            continue
+        x = np.array([[parameter_row(c)[p] for c in cases] for p in PARAMETERS])
+        _, weights = grey_relational(x, [discharge[c] for c in cases], rho)
+        out[name] = dict(zip(PARAMETERS, map(float, weights)))
+    return out
+
+
+def run_frames(store_path: str, cases: list[str], frame_interval: float, threads: int, say=print):
+    from pydem.frames import FrameStore
+    from pydem.rigs import RIGS, load
+    store = FrameStore(store_path)
+    done = set(store.cases())
+    cls, cfg_cls = RIGS["hopper"]
+    for case in cases:
+        if case in done:
+            say(f"  {case}: in the store already")
+            continue
+        cfg = load(cfg_cls, "default", None, [f"case={case}", f"frame_interval={frame_interval}", f"num_threads={threads}"])
+        t0 = time.perf_counter()
+        res = cls(cfg).run(seed=0, images=True)
+        t_dis = res.metrics["discharge_time"].value
+        if not np.isfinite(t_dis):
+            say(f"  {case}: did not empty ({res.metrics['discharge_time'].note}); not stored")
+            continue
+        store.write_case(case, res.images, res.series["frame_time"], t_dis, res.series["frame_nrrp"],
+                         {"packing": case.split("-")[0], **{f"param_{k}": v for k, v in parameter_row(case).items()},
+                          "particles": res.info["particles"], "frame_interval": frame_interval})
+        say(f"  {case}: {len(res.images)} frames, discharge time {t_dis:.3f} s, {time.perf_counter() - t0:.0f} s")
+
+
+def main(argv=None) -> int:
+    from pydem.rigs.hopper import TABLE1
+    ap = argparse.ArgumentParser(prog="python -m nn.seed001")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    f = sub.add_parser("frames", help="run the Table 1 cases into the frame store (resumable)")
+    f.add_argument("--store", required=True)
+    f.add_argument("--cases", nargs="+", default=list(TABLE1), choices=list(TABLE1))
+    f.add_argument("--frame-interval", type=float, default=0.02, help="s between frames (default 0.02)")
+    f.add_argument("--threads", type=int, default=1)
+    g = sub.add_parser("gra", help="grey relational analysis of the stored cases' discharge times")
+    g.add_argument("--store", required=True)
+    g.add_argument("--rho", type=float, default=0.5)
+    args = ap.parse_args(argv)
+    if args.cmd == "frames":
+        run_frames(args.store, args.cases, args.frame_interval, args.threads)
+        return 0
+    from pydem.frames import FrameStore
+    store = FrameStore(args.store)
+    discharge = {c: float(store.read_case(c)["discharge_time"]) for c in store.cases()}
+    if len(discharge) < 2:
+        print(f"{args.store}: {len(discharge)} case(s) stored; the GRA needs two or more", file=sys.stderr)
+        return 2
+    tables = gra_tables(discharge, args.rho)
+    print("| parameter | " + " | ".join(tables) + " |\n|---|" + "---|" * len(tables))
+    for p in PARAMETERS:
+        print(f"| {p} | " + " | ".join(f"{t[p]:.2f} %" for t in tables.values()) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
