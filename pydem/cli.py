@@ -53,6 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--out", help="result file (.h5, or JSON for any other name)")
     rig.add_argument("--frames", help="directory for PNG frames")
     rig.add_argument("--vtk", help="directory for a VTK time series at the frame times (ParaView: open particles.pvd)")
+    rig.add_argument("--checkpoint", help="directory for the run's checkpoints; a rerun with it resumes (ring shear)")
+    rig.add_argument("--checkpoint-every", type=float, default=600.0, help="seconds of wall time between checkpoints")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
     from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_locus
@@ -88,9 +90,15 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"pydem: cannot write the output: {exc}", file=sys.stderr)
         return 2
+    extra = {}
+    if args.checkpoint:
+        if args.name != "ring-shear":
+            print(f"pydem: --checkpoint: the {args.name} rig does not checkpoint yet (the ring shear does)", file=sys.stderr)
+            return 2
+        extra = {"checkpoint": args.checkpoint, "checkpoint_every": args.checkpoint_every}
     progress = None if args.quiet else ProgressLine()
     try:
-        result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress, vtk_dir=args.vtk)
+        result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress, vtk_dir=args.vtk, **extra)
     except (DemError, ValueError) as exc:
         if progress:
             progress.done()

@@ -18,7 +18,10 @@ Steady flow: the mean shear stress of the last two quarters of a pre-shear diffe
 than `steady_tolerance` (else it continues, up to `max_preshear`)."""
 from __future__ import annotations
 
+import json
 import math
+import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -92,20 +95,42 @@ class RingShear:
         self.config = config or RingShearConfig.preset("default")
 
     def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
-            vtk_dir: str | Path | None = None) -> RigResult:
+            vtk_dir: str | Path | None = None, checkpoint: str | Path | None = None, checkpoint_every: float = 600.0,
+            max_phases: int | None = None) -> RigResult | None:
         """The Schulze procedure, phase by phase (module docstring); the metrics from the
-        measured lid stresses by the pure functions below."""
+        measured lid stresses by the pure functions below.
+
+        checkpoint: a directory where the run saves its state (an HDF5 snapshot and the
+        protocol's state) at the first phase boundary after every `checkpoint_every` seconds of
+        wall time; a run given a directory holding a checkpoint of the same configuration and
+        seed resumes from it, with results bitwise those of an uninterrupted run. max_phases:
+        stop (with a checkpoint, returning None) after that many phases of this call — a run
+        split across batch jobs."""
         c = self.config
-        t = Tester(c, params_from(c.params, params), seed, Frames(frames_dir, vtk_dir), progress, self._planned_time())
-        t.load_to(c.preshear_stress, 1.0)
-        steady = [t.preshear(c.first_preshear_displacement)]
-        points = []
-        for frac in [f for f in c.shear_points for _ in range(c.shear_repeats)]:
-            steady.append(t.preshear(c.preshear_displacement))
-            t.load_to(frac * c.preshear_stress)
-            tau_sh, sigma_sh = t.shear_to_failure()
-            points.append((frac, sigma_sh, tau_sh))
-            t.load_to(c.preshear_stress)
+        p = params_from(c.params, params)
+        ck = Checkpoint(checkpoint, self._signature(p, seed)) if checkpoint else None
+        state = ck.load() if ck else None
+        t = Tester(c, p, seed, Frames(frames_dir, vtk_dir), progress, self._planned_time(), resume=state)
+        steady = [tuple(np.asarray(a) for a in part) for part in state["steady"]] if state else []
+        points = [tuple(q) for q in state["points"]] if state else []
+        plan = self._plan()
+        k0 = state["phase"] if state else 0
+        last_save = time.perf_counter()
+        for k in range(k0, len(plan)):
+            kind, arg = plan[k]
+            if kind == "load":
+                t.load_to(*arg)
+            elif kind == "preshear":
+                steady.append(t.preshear(arg))
+            else:
+                tau_sh, sigma_sh = t.shear_to_failure()
+                points.append((arg, sigma_sh, tau_sh))
+            stop = max_phases is not None and k + 1 - k0 >= max_phases and k + 1 < len(plan)
+            if ck and (stop or time.perf_counter() - last_save >= checkpoint_every) and k + 1 < len(plan):
+                ck.save(t, k + 1, steady, points)
+                last_save = time.perf_counter()
+            if stop:
+                return None
         res = RigResult("ring-shear")
         tau_pre, sigma_pre, z_lid = preshear_metrics(steady, res.metrics)
         shear_point_metrics(points, res.metrics)
@@ -120,9 +145,28 @@ class RingShear:
         res.frames = [f for f in t.frames if f]
         res.info.update({"particles": c.particles, "steps": t.st.steps, "dt": d.dt, "simulated_time": d.time,
                          "engine_profile": d.profile(), "wall_seconds": t.st.wall_seconds(), "seed": seed,
-                         "phases": t.phase_log,
+                         "phases": t.phase_log, "resumed_at_phase": k0 if state else None,
                          "shear_points": [{"fraction": f, "sigma": s, "tau_peak": tp} for f, s, tp in points]})
+        if ck:
+            ck.remove()
         return res
+
+    def _plan(self) -> list[tuple[str, object]]:
+        """The procedure as a list of phases: (load, (sigma, max seconds)), (preshear,
+        displacement), (shear, fraction)."""
+        c = self.config
+        plan = [("load", (c.preshear_stress, 1.0)), ("preshear", c.first_preshear_displacement)]
+        for frac in [f for f in c.shear_points for _ in range(c.shear_repeats)]:
+            plan += [("preshear", c.preshear_displacement), ("load", (frac * c.preshear_stress, 0.5)), ("shear", frac),
+                     ("load", (c.preshear_stress, 0.5))]
+        return plan
+
+    def _signature(self, p: Params, seed: int) -> str:
+        """What a checkpoint must match to be resumed: the configuration, the parameters, the seed."""
+        from .config import describe
+        cfg = {k: v if isinstance(v, (int, float, str, bool)) else str(v) for k, v, _, _ in describe(self.config)
+               if k != "num_threads"}
+        return json.dumps({"config": cfg, "params": str(p), "seed": seed, "protocol": self.protocol}, sort_keys=True)
 
     def _planned_time(self) -> float:
         c = self.config
@@ -135,7 +179,8 @@ class Tester:
     """The rig in one state: the filled, settled trough under its lid, and the phases of the
     procedure as methods (each samples the lid stresses into the stepper's series)."""
 
-    def __init__(self, c: RingShearConfig, p: Params, seed: int, out: Frames, progress, planned_time: float):
+    def __init__(self, c: RingShearConfig, p: Params, seed: int, out: Frames, progress, planned_time: float,
+                 resume: dict | None = None):
         if not c.outer_radius > c.inner_radius + 4 * c.diameter:
             raise ValueError("outer_radius must exceed inner_radius by at least 4 diameters")
         self.c, self.p, self.out = c, p, out
@@ -144,6 +189,20 @@ class Tester:
         self.area = math.pi * (ro ** 2 - ri ** 2)
         self.moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
         self.omega = c.shear_speed / (0.5 * (ri + ro))
+        if resume is not None:  # the state of a checkpoint (Checkpoint.load): no filling, no settling
+            from ..domain import Domain
+            from ..walls import MeshWall
+            self.d = Domain.from_snapshot(resume["snapshot"])
+            self.d.num_threads = c.num_threads
+            self.trough, self.lid = MeshWall(self.d, 0), MeshWall(self.d, 1)
+            self.lid.reset_mean_force()  # as the phase's last sample left it: averaging, from zero (not in snapshots)
+            self.height, self.lid_z0 = resume["height"], resume["lid_z0"]
+            self.st = Stepper(self.d, progress, planned_time=planned_time)
+            self.st.series = {k: list(v) for k, v in resume["series"].items()}
+            self.st.steps = resume["steps"]
+            self.frames, self.next_frame, self.phase_log = resume["frames"], resume["next_frame"], resume["phase_log"]
+            self.trough_moving = resume["trough_moving"]
+            return
         radii = size_distribution(rng, c.particles, dm, c.size_spread, c.psd_sizes, c.psd_passing)
         spacing = 1.05 * 2 * radii.max()
         ring = math.pi * ((ro - 0.55 * spacing) ** 2 - (ri + 0.55 * spacing) ** 2) / spacing ** 2
@@ -179,6 +238,7 @@ class Tester:
         self.lid = d.add_mesh_wall((v, lid_mesh[1]), material=mw)
         self.lid.reset_mean_force()
         self.frames, self.next_frame, self.phase_log = [], 0.0, []
+        self.trough_moving = False
 
     def lid_state(self) -> tuple[float, float]:
         """Lid stresses averaged over the steps since the previous sample (a snapshot rattles
@@ -202,8 +262,21 @@ class Tester:
             return False
         return each
 
+    def stop_trough(self):
+        """The trough stops at the start of the phase after a shear, not at the end of the shear:
+        so every phase ends right after a step, with valid forces, and a checkpoint written
+        there changes nothing (a snapshot of invalid forces would recompute them first)."""
+        if self.trough_moving:
+            self.trough.set_motion((0, 0, 0))
+            self.trough_moving = False
+
+    def turn_trough(self):
+        self.trough.set_motion((0, 0, 0), (0, 0, self.omega), (0, 0, 0))
+        self.trough_moving = True
+
     def load_to(self, sigma: float, max_seconds: float = 0.5):
         """Servo to sigma and wait until the lid holds it (5 samples within 3 %)."""
+        self.stop_trough()
         self.lid.set_servo(direction=(0, 0, -1), target_stress=sigma, area=self.area, max_speed=self.c.servo_speed,
                            proportional_band=0.3, filter_time=2e-3)
         record = self.sample("load")
@@ -219,7 +292,7 @@ class Tester:
         """Shears at sigma_pre until steady (or max_preshear); returns the tau, sigma and lid
         height samples of the steady part (its second half)."""
         c, st = self.c, self.st
-        self.trough.set_motion((0, 0, 0), (0, 0, self.omega), (0, 0, 0))
+        self.turn_trough()
         start = len(st.series.get("tau", []))
         chunk = min(0.05 * displacement / c.shear_speed, 0.01)  # >= 20 samples: quarters of 5+
         st.advance(displacement / c.shear_speed, chunk=chunk, each=self.sample("preshear"))
@@ -233,7 +306,6 @@ class Tester:
                     break
             st.advance(0.25 * displacement / c.shear_speed, chunk=chunk, each=self.sample("preshear"))
             total += 0.25 * displacement
-        self.trough.set_motion((0, 0, 0))
         half = start + (len(st.series["tau"]) - start) // 2
         self.phase_log.append(("preshear", total))
         return tuple(np.array(st.series[k][half:]) for k in ("tau", "sigma", "lid_z"))
@@ -242,7 +314,7 @@ class Tester:
         """Shears at the current load until tau falls below 90 % of its peak (after 0.3 d):
         (peak tau, sigma at the peak)."""
         c, st, d = self.c, self.st, self.d
-        self.trough.set_motion((0, 0, 0), (0, 0, self.omega), (0, 0, 0))
+        self.turn_trough()
         start = len(st.series["tau"])
         peak = -math.inf
         record = self.sample("shear")
@@ -256,10 +328,50 @@ class Tester:
             return (d.time - t_start) * c.shear_speed > 0.3 * c.diameter and tau < 0.9 * peak  # past the peak: failed
 
         st.advance(c.shear_displacement / c.shear_speed, chunk=0.1 * c.diameter / c.shear_speed, each=each)
-        self.trough.set_motion((0, 0, 0))
         taus = np.array(st.series["tau"][start:])
         self.phase_log.append(("shear", (d.time - t_start) * c.shear_speed))
         return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
+
+
+class Checkpoint:
+    """A ring-shear run's state at a phase boundary: <dir>/ring_shear.h5 (the domain's snapshot:
+    bitwise restart) and <dir>/ring_shear.json (the protocol's state and the signature of the
+    configuration, parameters and seed it belongs to). The JSON is written last, by rename: a
+    checkpoint exists only once both are complete. A phase ends right after a step (valid forces,
+    Tester.stop_trough) and a sample (the lid's mean-force accumulator just reset), so the
+    snapshot changes nothing and nothing else needs saving."""
+
+    def __init__(self, directory, signature: str):
+        self.dir = Path(directory)
+        self.signature = signature
+        self.snapshot, self.state = self.dir / "ring_shear.h5", self.dir / "ring_shear.json"
+
+    def load(self) -> dict | None:
+        if not self.state.exists():
+            return None
+        state = json.loads(self.state.read_text())
+        if state.get("signature") != self.signature:
+            raise ValueError(f"{self.state}: a checkpoint of another configuration, parameter set or seed "
+                             f"(remove it, or resume with the settings that made it)")
+        state["snapshot"] = str(self.snapshot)
+        return state
+
+    def save(self, t: "Tester", phase: int, steady, points):
+        self.dir.mkdir(parents=True, exist_ok=True)
+        tmp = self.dir / ".ring_shear.h5.tmp"
+        t.d.write_snapshot(tmp)
+        os.replace(tmp, self.snapshot)
+        state = {"signature": self.signature, "phase": phase, "height": t.height, "lid_z0": float(t.lid_z0),
+                 "series": t.st.series, "steps": t.st.steps, "frames": t.frames, "next_frame": t.next_frame,
+                 "phase_log": t.phase_log, "trough_moving": t.trough_moving, "steady": [[np.asarray(a).tolist() for a in part] for part in steady],
+                 "points": [list(q) for q in points]}
+        tmp = self.dir / ".ring_shear.json.tmp"
+        tmp.write_text(json.dumps(state))
+        os.replace(tmp, self.state)
+
+    def remove(self):
+        for f in (self.state, self.snapshot):
+            f.unlink(missing_ok=True)
 
 
 def preshear_metrics(steady: list[tuple[np.ndarray, np.ndarray, np.ndarray]], metrics: dict) -> tuple[float, float, float]:
