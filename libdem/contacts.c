@@ -5,9 +5,19 @@
 
 #include "internal.h"
 
+/* friction: the pair's mu_s; a contact slides when its tangential force is at mu_s times the
+ * normal force (to round-off); with cohesion the law caps at mu_s times the repulsive part, which
+ * this normal force (repulsion less cohesion) understates: such contacts may read as sliding. */
 static void put(dem_contact *c, dem_particle_id i, dem_particle_id j, int kind, int wall, int64_t tri, const double *point,
-                const double *normal, const double *force, double overlap)
+                const double *normal, const double *force, double overlap, double friction)
 {
+    const double fn = force[0] * normal[0] + force[1] * normal[1] + force[2] * normal[2];
+    const double t[3] = {force[0] - fn * normal[0], force[1] - fn * normal[1], force[2] - fn * normal[2]};
+    const double ft = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    c->normal_force = fn;
+    c->tangential_force = ft;
+    c->sliding = ft > 0.0 && ft >= friction * fn * (1.0 - 1e-9);
+    c->reserved = 0;
     c->i = i;
     c->j = j;
     c->kind = kind;
@@ -51,7 +61,8 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
             if (m < capacity) {
                 double u[3] = {n[0] / r, n[1] / r, n[2] / r}, q[3];
                 for (int a = 0; a < 3; a++) q[a] = xi[a] - (d->radius[i] - 0.5 * delta) * u[a];
-                put(out + m, d->id[i], d->id[j], DEM_CONTACT_PARTICLE, -1, -1, q, u, d->slot + 6 * k, delta);
+                put(out + m, d->id[i], d->id[j], DEM_CONTACT_PARTICLE, -1, -1, q, u, d->slot + 6 * k, delta,
+                    dem_pair_props(d, d->mat[i], d->mat[j])->def.friction);
             }
             m++;
         }
@@ -63,7 +74,7 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
                 double q[3];
                 for (int a = 0; a < 3; a++) q[a] = xi[a] - dist * pw->normal[a];
                 put(out + m, d->id[i], -1, DEM_CONTACT_PLANE, wl->wall[k], -1, q, pw->normal, wl->force + 3 * k,
-                    d->radius[i] - dist);
+                    d->radius[i] - dist, dem_pair_props(d, d->mat[i], pw->def.material)->def.friction);
             }
             m++;
         }
@@ -74,7 +85,8 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
                                      (xi[2] - q[2]) * (xi[2] - q[2]));
             if (m < capacity)
                 put(out + m, d->id[i], -1, DEM_CONTACT_MESH, tl->mesh[k], tl->tri[k], q, tl->normal + 3 * k,
-                    tl->force + 3 * k, d->radius[i] - dist);
+                    tl->force + 3 * k, d->radius[i] - dist,
+                    dem_pair_props(d, d->mat[i], d->meshes[tl->mesh[k]].material)->def.friction);
             m++;
         }
     }

@@ -76,7 +76,8 @@ def c_definition(maker, ctype: str, **given):
 # dem_contact's layout (include/dem/types.h); its size is checked against the C struct at import
 _CONTACT_DTYPE = np.dtype([("i", np.int64), ("j", np.int64), ("kind", np.int32), ("wall", np.int32),
                            ("triangle", np.int64), ("point", np.float64, 3), ("normal", np.float64, 3),
-                           ("force", np.float64, 3), ("overlap", np.float64)], align=True)
+                           ("force", np.float64, 3), ("overlap", np.float64), ("normal_force", np.float64),
+                           ("tangential_force", np.float64), ("sliding", np.int32), ("reserved", np.int32)], align=True)
 assert _CONTACT_DTYPE.itemsize == ffi.sizeof("dem_contact"), "dem_contact layout changed: update _CONTACT_DTYPE"
 
 
@@ -322,14 +323,15 @@ class Domain:
     def contacts(self) -> dict:
         """Every contact of the current state (dem_contacts_get) as numpy arrays: i, j (partner id,
         -1 for a wall), kind (0 particle, 1 plane wall, 2 mesh wall), wall, triangle, point (n, 3),
-        normal (n, 3, from the partner towards i), force (n, 3, on i), overlap."""
+        normal (n, 3, from the partner towards i), force (n, 3, on i), overlap, normal_force,
+        tangential_force, sliding (at the Coulomb limit)."""
         count = ffi.new("int64_t *")
         self._check(lib.dem_contacts_get(self._d, ffi.NULL, 0, count))
         n = int(count[0])
         buf = ffi.new("dem_contact[]", max(n, 1))
         self._check(lib.dem_contacts_get(self._d, buf, n, count))
         raw = np.frombuffer(ffi.buffer(buf, n * ffi.sizeof("dem_contact")), dtype=_CONTACT_DTYPE)
-        return {name: raw[name].copy() for name in _CONTACT_DTYPE.names}
+        return {name: raw[name].copy() for name in _CONTACT_DTYPE.names if name != "reserved"}
 
     # ---- stress -------------------------------------------------------------------------------
     def region_stress(self, kind: str = "box", *, lo=(0, 0, 0), hi=(1, 1, 1), centre=(0, 0, 0), axis: int = 2,

@@ -88,6 +88,10 @@ typedef struct dem_contact {
     double normal[3];      /* unit normal, from the partner towards i */
     double force[3];       /* N, the contact force on i (the partner gets the opposite) */
     double overlap;        /* m */
+    double normal_force;   /* N, force . normal (> 0 pushes i away from the partner) */
+    double tangential_force; /* N, the magnitude of the force's tangential part */
+    int32_t sliding;       /* 1: the tangential force is at the Coulomb limit mu_s F_n (the contact slips) */
+    int32_t reserved;
 } dem_contact;
 
 /* Accumulated wall-clock time per phase since creation or the last reset. */

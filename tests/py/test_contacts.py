@@ -60,3 +60,26 @@ def test_small_buffer_is_an_error_naming_the_count():
     assert _lib.dem_contacts_get(d._d, one, 1, n) == _lib.DEM_ERR_INVALID_ARGUMENT
     assert "2 contacts, room for 1" in _ffi.string(_lib.dem_domain_last_error(d._d)).decode()
     assert one[0].kind == 1 and one[0].j == -1  # the first one was written
+
+
+def test_normal_tangential_split_and_the_sliding_flag():
+    """A sphere pushed along the floor slides (its friction is at mu F_n: flagged); one at rest
+    on the floor does not; the split adds back to the force."""
+    d = pydem.Domain()
+    m = d.add_material()
+    d.set_pair(m, m, friction=0.4)
+    d.add_plane_wall(material=m)
+    z = 0.002 - 2e-6
+    d.add_particles(np.array([[0.02, 0.05, z], [0.07, 0.05, z]]), 0.002, m,
+                    velocities=np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]))
+    d.step(20)
+    c = d.contacts()
+    assert list(c["kind"]) == [1, 1]
+    n, f = c["normal"], c["force"]
+    assert np.allclose(c["normal_force"], np.sum(f * n, axis=1), rtol=1e-14)
+    tang = f - c["normal_force"][:, None] * n
+    assert np.allclose(c["tangential_force"], np.linalg.norm(tang, axis=1), rtol=1e-12, atol=1e-18)
+    moving = int(np.flatnonzero(c["i"] == 0)[0])
+    assert c["sliding"][moving] == 1 and c["tangential_force"][moving] == pytest.approx(0.4 * c["normal_force"][moving], rel=1e-9)
+    assert c["sliding"][1 - moving] == 0
+    assert np.all(c["tangential_force"] <= 0.4 * c["normal_force"] * (1 + 1e-9))
