@@ -1,0 +1,89 @@
+"""Hidden-effect sets made by the rigs themselves at their default presets, in two steps so the
+expensive part runs once: `run` draws a truth per set (base parameters uniform in the campaign
+box, the named effect at a random strength, or none), runs the rigs on the validation
+programme (ring shear at 1, 2, 5 kPa with shear points 40/60/80 %, the angle of repose, the
+hopper at three slot widths) and appends the raw values to a journal (resumable: one line per
+set); `diagnose` adds the lab noise, writes each set as a measurement file and runs the
+diagnosis on the given stores.
+
+    .venv/bin/python bench/diagnosis_dem_sets.py run --kinds null cohesion_sjkr --journal bench/results/dem_sets_default.jsonl
+    .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from pydem.calibration import synthetic  # noqa: E402
+from pydem.calibration.quantities import Observation, Quantity  # noqa: E402
+from pydem.calibration.setup import DEFAULT_STORES, load_setup  # noqa: E402
+
+
+
+def run(args):
+    setup = load_setup(args.stores, say=lambda *_: None)
+    journal = Path(args.journal)
+    done = len(journal.read_text().splitlines()) if journal.exists() else 0
+    for k, kind in enumerate(args.kinds):
+        if k < done:
+            continue
+        rng = np.random.default_rng(args.seed + k)
+        truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, None if kind == "null" else kind)
+        obs = synthetic.programme(setup.nets)
+        values = synthetic.rig_values(setup.stores, truth.inputs(setup.candidates), obs, seed=1000 + k, threads=1)
+        row = {"kind": kind, "truth": {"theta": truth.theta, "effect": truth.effect, "parameter": truth.parameter,
+                                        "strength": truth.strength},
+               "rows": [{"rig": o.quantity.rig, "metric": o.quantity.metric, "conditions": o.conditions,
+                         "label": o.label, "value": values.get(i)} for i, o in enumerate(obs)]}
+        with open(journal, "a") as f:
+            f.write(json.dumps(row) + "\n")
+        print(f"set {k} ({kind}) done: {sum(r['value'] is not None for r in row['rows'])} of {len(obs)} rows", flush=True)
+
+
+def diagnose(args):
+    from pydem.calibration.diagnose import diagnose as run_diagnosis
+    setup = load_setup(args.stores, say=lambda *_: None)
+    out = []
+    for k, line in enumerate(Path(args.journal).read_text().splitlines()):
+        row = json.loads(line)
+        rng = np.random.default_rng(5000 + k)
+        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"])
+               for r in row["rows"] if r["value"] is not None]
+        vals = {i: r["value"] for i, r in enumerate(x for x in row["rows"] if x["value"] is not None)}
+        noisy = synthetic._fill(obs, vals, setup.nets, rng)
+        d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
+        t = row["truth"]
+        out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,
+                    "chi2_before": d.base.chi2_per_dof, "chi2_after": d.after.chi2_per_dof if d.after else None,
+                    "best": [(c.effect, round(c.statistic, 2), c.p_value) for c in d.candidates[:2]]})
+        print(f"set {k}: {row['kind']:14s} truth {t['effect']}={t['strength']}  -> {d.verdict} {d.effect or ''}  "
+              f"chi2/dof {d.base.chi2_per_dof:.2f}" + (f" -> {d.after.chi2_per_dof:.2f}" if d.after else ""), flush=True)
+    Path(args.journal).with_suffix(".diagnosed.json").write_text(json.dumps(out, indent=1, default=float))
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("--kinds", nargs="+", required=True, help="null or a candidate effect's name, one per set")
+    r.add_argument("--journal", required=True)
+    r.add_argument("--seed", type=int, default=300)
+    r.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
+    d = sub.add_parser("diagnose")
+    d.add_argument("--journal", required=True)
+    d.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
+    args = ap.parse_args()
+    run(args) if args.cmd == "run" else diagnose(args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
