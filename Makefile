@@ -89,8 +89,9 @@ test-minimal:
 	  $(BUILD)/minimal/libdem.a -lcmocka -lm
 	@cd $(BUILD)/minimal && ./test_minimal_build
 
-# every C test again under AddressSanitizer + UndefinedBehaviorSanitizer (+ leak check)
-SAN_OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+# every C test again under AddressSanitizer + UndefinedBehaviorSanitizer (+ leak check), with the
+# library's internal invariants checked (DEM_CHECKS)
+SAN_OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all -DDEM_CHECKS
 test-sanitize:
 	@echo "== C tests under ASan + UBSan"
 	@mkdir -p $(BUILD)

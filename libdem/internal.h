@@ -205,6 +205,16 @@ dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)
     ;
 void dem_clear_error(dem_domain *d);
 
+/* Internal invariants, checked in builds with -DDEM_CHECKS (the sanitizer build of `make test`);
+ * a broken one calls the hook set by dem_set_assert_hook, else prints and aborts. Free of cost
+ * otherwise. */
+void dem_assert_fail(const char *expr, const char *file, int line);
+#ifdef DEM_CHECKS
+#define DEM_ASSERT(cond) ((cond) ? (void)0 : dem_assert_fail(#cond, __FILE__, __LINE__))
+#else
+#define DEM_ASSERT(cond) ((void)0)
+#endif
+
 /* materials.c */
 const pair_props *dem_pair_props(const dem_domain *d, int a, int b);
 void dem_pair_recompute(dem_domain *d, int a, int b);

@@ -239,6 +239,30 @@ static void transfer_pair_history(const pair_list *old, int64_t old_rows, int32_
     for (int a = 0; a < 6; a++) pl->hist[6 * k + a] = 0.0;
 }
 
+/* The invariants every reader of the lists relies on (checking builds only, DEM_CHECKS): row
+ * offsets that rise and fit the arrays, partners that exist and come later in memory unless
+ * across a periodic face, ids and indices that map to each other, the transposed index whole. */
+static void check_lists(const dem_domain *d)
+{
+#ifdef DEM_CHECKS
+    const pair_list *pl = &d->pairs_cur;
+    const wall_list *wl = &d->walls_cur;
+    const tri_list *tl = &d->tris_cur;
+    DEM_ASSERT(pl->n_rows == d->n && pl->start[0] == 0 && pl->start[d->n] == pl->count && pl->count <= pl->capacity);
+    DEM_ASSERT(wl->start[0] == 0 && wl->start[d->n] == wl->count && wl->count <= wl->capacity);
+    DEM_ASSERT(tl->start[0] == 0 && tl->start[d->n] == tl->count && tl->count <= tl->capacity);
+    for (int64_t i = 0; i < d->n; i++) {
+        DEM_ASSERT(pl->start[i] <= pl->start[i + 1] && wl->start[i] <= wl->start[i + 1] && tl->start[i] <= tl->start[i + 1]);
+        DEM_ASSERT(d->index_of_id[d->id[i]] == (int32_t)i);
+        for (int64_t k = pl->start[i]; k < pl->start[i + 1]; k++)
+            DEM_ASSERT(pl->j[k] >= 0 && pl->j[k] < d->n && (pl->j[k] > i || pl->image[k] != 13));
+    }
+    DEM_ASSERT(d->trans_start[d->n] == pl->count);
+#else
+    (void)d;
+#endif
+}
+
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
 {
     const int64_t n_old = d->n;
@@ -454,6 +478,7 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
 
     s = dem_mesh_candidates(d);
     if (s != DEM_OK) return s;
+    check_lists(d);
     d->need_rebuild = 0;
     d->profile.neighbor_builds++;
     return DEM_OK;

@@ -81,3 +81,17 @@ int dem_realloc_all(void **arrays[], int n_arrays, size_t count, size_t elem)
 }
 
 int dem_is_finite(double x) { return isfinite(x) ? 1 : 0; }
+
+static dem_assert_hook assert_hook; /* process-wide, like an allocator: set once, before the runs */
+
+void dem_set_assert_hook(dem_assert_hook hook) { assert_hook = hook; }
+
+void dem_assert_fail(const char *expr, const char *file, int line)
+{
+    if (assert_hook) {
+        assert_hook(expr, file, line);
+        return;
+    }
+    fprintf(stderr, "libdem: internal invariant broken: %s (%s:%d)\n", expr, file, line);
+    abort();
+}

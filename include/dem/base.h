@@ -48,6 +48,11 @@ typedef enum dem_status {
     DEM_ERR_UNSUPPORTED = -15      /* a feature this build left out (make HDF5=0 or PNG=0) */
 } dem_status;
 
+/* Called when an internal invariant fails in a checking build (-DDEM_CHECKS): the expression,
+ * file and line. NULL (the default) prints them to stderr and aborts. */
+typedef void (*dem_assert_hook)(const char *expression, const char *file, int line);
+DEM_API void dem_set_assert_hook(dem_assert_hook hook);
+
 /* Short fixed name of a status ("DEM_ERR_OVERLAP"); never NULL. */
 DEM_API const char *dem_status_name(dem_status status);
 

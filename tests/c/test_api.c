@@ -257,6 +257,27 @@ static void test_periodic_too_small(void **st)
     dem_domain_destroy(d);
 }
 
+/* The assert hook receives a broken invariant (the checking build raises them: make test-sanitize). */
+void dem_assert_fail(const char *expr, const char *file, int line); /* internal; the static library has it */
+static const char *hooked_expr;
+static int hooked_line;
+static void hook(const char *expr, const char *file, int line)
+{
+    (void)file;
+    hooked_expr = expr;
+    hooked_line = line;
+}
+
+static void test_assert_hook(void **st)
+{
+    (void)st;
+    dem_set_assert_hook(hook);
+    dem_assert_fail("start[i] <= start[i + 1]", "neighbor.c", 42);
+    assert_string_equal(hooked_expr, "start[i] <= start[i + 1]");
+    assert_int_equal(hooked_line, 42);
+    dem_set_assert_hook(NULL);
+}
+
 /* Read-back buffers carry their capacity: a short one is refused, untouched, with the counts. */
 static void test_getters_check_capacity(void **st)
 {
@@ -291,6 +312,7 @@ int main(void)
         cmocka_unit_test(test_periodic_too_small),
         cmocka_unit_test(test_lifecycle_edges),
         cmocka_unit_test(test_getters_check_capacity),
+        cmocka_unit_test(test_assert_hook),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
