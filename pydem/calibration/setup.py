@@ -18,7 +18,8 @@ from .surrogates import load_or_train
 # and at their default presets (the ones measurements made with the default rigs are compared with)
 TINY_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_aor_tiny.h5",
                "data/campaigns/diag_hopper_tiny.h5")
-DEFAULT_STORES = TINY_STORES
+DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/diag_aor_default.h5",
+                  "data/campaigns/diag_hopper_default.h5")
 
 
 @dataclass
