@@ -51,12 +51,8 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
         for (int64_t k = pl->start ? pl->start[i] : 0; pl->start && k < pl->start[i + 1]; k++) {
             if (!pl->active[k]) continue;
             const int32_t j = pl->j[k];
-            double n[3], r2 = 0.0;
-            for (int a = 0; a < 3; a++) {
-                n[a] = xi[a] - (d->x[3 * j + a] + dem_image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]));
-                r2 += n[a] * n[a];
-            }
-            const double r = sqrt(r2), delta = d->radius[i] + d->radius[j] - r;
+            double n[3], r;
+            const double delta = dem_pair_separation(d, i, k, n, &r);
             if (delta <= 0.0) continue;
             if (m < capacity) {
                 double u[3] = {n[0] / r, n[1] / r, n[2] / r}, q[3];

@@ -3,6 +3,7 @@
 #define DEM_INTERNAL_H
 
 #include "dem/dem.h"
+#include <math.h>
 #include <stdarg.h>
 
 #define DEM_MAX_EFFECTS_PER_PAIR 4
@@ -226,6 +227,21 @@ double dem_restitution_for_damping_factor(double factor);
 
 /* neighbor.c */
 extern const double dem_image_sign[27][3]; /* periodic image code -> shift in box lengths */
+
+/* Pair-list entry k of row i as the stress and the contact list read it: n = x_i - x_j (j's
+ * periodic image), *dist = |n|; returns the overlap r_i + r_j - |n| (<= 0: not touching). */
+static inline double dem_pair_separation(const dem_domain *d, int64_t i, int64_t k, double n[3], double *dist)
+{
+    const pair_list *pl = &d->pairs_cur;
+    const int32_t j = pl->j[k];
+    double r2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        n[a] = d->x[3 * i + a] - (d->x[3 * j + a] + dem_image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]));
+        r2 += n[a] * n[a];
+    }
+    *dist = sqrt(r2);
+    return d->radius[i] + d->radius[j] - *dist;
+}
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask);
 int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 

@@ -121,12 +121,8 @@ dem_status dem_region_stress(dem_domain *d, const dem_region *g, dem_stress *out
             const int in_j = inside(g, d->x + 3 * j);
             if (!in_i && !in_j) continue;
             const double *f = d->slot + 6 * k; /* force on i */
-            double n[3], r2 = 0.0;
-            for (int a = 0; a < 3; a++) {
-                n[a] = xi[a] - (d->x[3 * j + a] + dem_image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]));
-                r2 += n[a] * n[a];
-            }
-            const double r = sqrt(r2), delta = d->radius[i] + d->radius[j] - r;
+            double n[3], r;
+            const double delta = dem_pair_separation(d, i, k, n, &r);
             if (delta <= 0.0) continue;
             const double ci = d->radius[i] - 0.5 * delta, cj = d->radius[j] - 0.5 * delta;
             if (in_i) {
