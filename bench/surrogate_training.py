@@ -3,7 +3,7 @@
     .venv/bin/python bench/surrogate_training.py data/campaigns/ring_shear_cell.h5 --runs 105
     .venv/bin/python bench/surrogate_training.py data/campaigns/aor_default.h5 --metrics angle_of_repose
 
-Per metric, on the design points' means (replicates averaged, as `pydem calibrate` does):
+Per metric, on the design points' means (replicates averaged):
 1. a Gaussian process (ARD squared-exponential kernel + a noise term, maximum marginal
    likelihood): its noise sd estimates the run-to-run scatter, 1 - noise^2 / var the R^2 a
    perfect model gets on these targets, and its leave-one-out R^2 what a smooth interpolator
