@@ -88,12 +88,11 @@ def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, th
     keep = np.ones(len(pts), bool)
     misfit = np.zeros(len(pts))
     natives = {}
-    for k, (net, (c, a)) in enumerate(zip(model.nets, model._maps)):
+    for k, net in enumerate(model.nets):
         if id(net) not in natives:  # a net that cannot be exported (a test's closed form) runs in numpy
             natives[id(net)] = (NativeMLP(text=weights_text(net.export_arrays())) if hasattr(net, "export_arrays")
                                 else lambda x, _threads, net=net: net(x))
-        x = c + pts @ a.T  # the net's inputs: free parameters, neutral values, this row's conditions
-        pred = natives[id(net)](x, threads)
+        pred = natives[id(net)](model.row_inputs(k, pts), threads)
         keep &= np.abs(pred - model.y[k]) <= window * abs(model.y[k])
         misfit += ((pred - model.y[k]) / model.sigma[k]) ** 2
     seconds = time.perf_counter() - t0

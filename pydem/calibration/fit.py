@@ -55,6 +55,12 @@ class Model:
         a = np.column_stack([self._inputs_of(o, net, np.eye(k)[j]) - c for j in range(k)]) if k else np.zeros((len(c), 0))
         return c, a
 
+    def row_inputs(self, k: int, p: np.ndarray) -> np.ndarray:
+        """(m, inputs): row k's net inputs at the free-parameter points p (m, k) — the free
+        parameters, the candidates' neutral values and the row's conditions."""
+        c, a = self._maps[k]
+        return c + np.atleast_2d(p) @ a.T
+
     def predict(self, p: np.ndarray) -> np.ndarray:
         """p: (m, k) or (k,) -> predictions (m, n) or (n,)."""
         p2 = np.atleast_2d(p)
