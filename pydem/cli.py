@@ -53,7 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--out", help="result file (.h5, or JSON for any other name)")
     rig.add_argument("--frames", help="directory for PNG frames")
     rig.add_argument("--vtk", help="directory for a VTK time series at the frame times (ParaView: open particles.pvd)")
-    rig.add_argument("--checkpoint", help="directory for the run's checkpoints; a rerun with it resumes (ring shear)")
+    rig.add_argument("--checkpoint", help="directory for the run's checkpoints; a rerun with it resumes, bitwise")
     rig.add_argument("--checkpoint-every", type=float, default=600.0, help="seconds of wall time between checkpoints")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
@@ -92,9 +92,6 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     extra = {}
     if args.checkpoint:
-        if args.name != "ring-shear":
-            print(f"pydem: --checkpoint: the {args.name} rig does not checkpoint yet (the ring shear does)", file=sys.stderr)
-            return 2
         extra = {"checkpoint": args.checkpoint, "checkpoint_every": args.checkpoint_every}
     progress = None if args.quiet else ProgressLine()
     try:
@@ -107,7 +104,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         if progress:
             progress.done()
-        print("pydem: interrupted (frames written so far are kept)", file=sys.stderr)
+        print("pydem: interrupted (frames written so far are kept" +
+              (f"; the same command resumes from the last checkpoint in {args.checkpoint})" if args.checkpoint else ")"),
+              file=sys.stderr)
         return 130
     if progress:
         progress.done()

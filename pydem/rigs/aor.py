@@ -16,6 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
+from ..domain import Domain
+from ..walls import MeshWall
+from .checkpoint import Checkpoint, CheckpointStop, signature
 from .common import (Frames, Stepper, lattice_fill, make_domain, params_from, size_distribution, stable_dt,
                      translational_energy_per_particle)
 from .config import Params, default_threads, knob
@@ -60,9 +63,94 @@ class AngleOfRepose:
         self.config = config or AorConfig.preset("default")
 
     def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
-            vtk_dir: str | Path | None = None) -> RigResult:
+            vtk_dir: str | Path | None = None, checkpoint: str | Path | None = None, checkpoint_every: float = 600.0,
+            stop_at: float | None = None) -> RigResult | None:
+        """Fill, settle, lift, come to rest; the angle by the module's estimator.
+
+        checkpoint: a directory where the run saves its state (pydem.rigs.checkpoint) every
+        `checkpoint_every` seconds of wall time; given a directory with a checkpoint of the same
+        configuration, parameters and seed, the run resumes from it, bitwise. stop_at: save and
+        return None at this simulated time (a run split across batch jobs)."""
         c = self.config
         p = params_from(c.params, params)
+        ck = Checkpoint(checkpoint, "aor", signature(self, p, seed), checkpoint_every, stop_at) if checkpoint else None
+        saved = ck.load() if ck else None
+        dmean = c.diameter
+        half = c.base_radius + 6 * dmean
+        out = Frames(frames_dir, vtk_dir)
+        if saved:
+            d = Domain.from_snapshot(saved["snapshot"])
+            d.num_threads = c.num_threads
+            cyl = MeshWall(d, 1)
+            s = saved["protocol"]
+            out.restore(saved["frames"])
+        else:
+            d, cyl = self._build(p, seed)
+            s = {"phase": 0, "frames": [], "next_frame": 0.0}
+        mass = p.density * 4 / 3 * math.pi * (0.5 * dmean) ** 3
+        ke_rest = c.rest_energy * mass * 9.81 * dmean
+        st = Stepper(d, progress, planned_time=c.max_time)
+        if saved:
+            st.restore(saved["stepper"])
+        if ck:
+            st.attach_checkpoint(ck, lambda: {"protocol": s, "frames": out.state()})
+        resumed_at = d.time if saved else None
+
+        def each():
+            x = d.positions
+            off = (x[:, 2] < -dmean) | (np.hypot(x[:, 0], x[:, 1]) > c.base_radius + dmean)
+            lost = d.ids[off]  # rolled off the base disk: gone, as in the lab
+            if len(lost):
+                d.remove_particles(lost)
+            ke = translational_energy_per_particle(d, p.density)
+            st.record(time=d.time, kinetic_energy=ke, cylinder_z=cyl.pose[0][2], particles=len(d))
+            if out.active and d.time >= s["next_frame"]:
+                s["frames"].append(out.write(d, f"aor_{len(s['frames']):04d}.png",
+                                             window=((-half, half), (-0.1 * half, 0.995 * half))))
+                s["next_frame"] += c.frame_interval
+            return False
+
+        def at_rest_after(t0: float):
+            return lambda: each() or (d.time > t0 and translational_energy_per_particle(d, p.density) < ke_rest)
+
+        try:
+            if s["phase"] == 0:  # 1. settle the filled cylinder
+                st.advance(0.1, each=each)
+                s["phase"] = 1
+            if s["phase"] == 1:
+                st.advance(c.max_time, each=at_rest_after(0.15))
+                s["density"] = list(self._bulk_density(d, p, c.cylinder_radius, dmean))
+                # 2. lift until the cylinder's bottom is above the material, then take it away
+                s["top"] = float((d.positions[:, 2] + d.radii).max())
+                cyl.set_motion(velocity=(0.0, 0.0, c.lift_speed))
+                s["phase"] = 2
+            if s["phase"] == 2:
+                st.advance(c.max_time, each=lambda: each() or cyl.pose[0][2] > s["top"] + dmean)
+                cyl.set_motion(velocity=(0.0, 0.0, 0.0))
+                s["lift_end"] = d.time
+                s["rest_time"] = max(0.0, c.max_time - d.time)
+                s["phase"] = 3
+            # 3. the heap comes to rest
+            at_rest = st.advance(s["rest_time"], each=at_rest_after(s["lift_end"] + 0.1))
+        except CheckpointStop:
+            return None
+        angle, angle_se, n_sectors = heap_angle(d.positions, d.radii, dmean)
+        res = RigResult("aor")
+        res.metrics["angle_of_repose"] = Metric(angle, angle_se, "deg", f"surface fit, {n_sectors} quadrants")
+        res.metrics["bulk_density"] = Metric(*s["density"], "kg/m^3", "filled cylinder, 3 slabs")
+        res.series = {k: np.asarray(v) for k, v in st.series.items()}
+        res.frames = [f for f in s["frames"] if f]
+        res.info = {"particles": c.particles, "particles_on_base": len(d), "steps": st.steps, "dt": d.dt,
+                    "simulated_time": d.time, "at_rest": bool(at_rest), "wall_seconds": st.wall_seconds(),
+                    "engine_profile": d.profile(), "resumed_at": resumed_at,
+                    "seed": seed, "estimator": __doc__.split("Estimator")[1].split("Bulk density")[0].strip()}
+        if ck:
+            ck.remove()
+        return res
+
+    def _build(self, p: Params, seed: int):
+        """The domain with the base disk and the filled cylinder: (domain, the cylinder wall)."""
+        c = self.config
         rng = np.random.default_rng(seed)
         dmean, rc = c.diameter, c.cylinder_radius
         radii = size_distribution(rng, c.particles, dmean, c.size_spread, c.psd_sizes, c.psd_passing)
@@ -84,49 +172,7 @@ class AngleOfRepose:
                            lambda g: np.hypot(g[:, 0], g[:, 1]) < inner, count=c.particles, jitter=0.02)
         d.add_particles(pos, radii, mp)
         d.dt = stable_dt(d)
-        mass = p.density * 4 / 3 * math.pi * (0.5 * dmean) ** 3
-        ke_rest = c.rest_energy * mass * 9.81 * dmean
-        st = Stepper(d, progress, planned_time=c.max_time)
-        frames, next_frame = [], [0.0]
-        out = Frames(frames_dir, vtk_dir)
-
-        def each():
-            x = d.positions
-            off = (x[:, 2] < -dmean) | (np.hypot(x[:, 0], x[:, 1]) > c.base_radius + dmean)
-            lost = d.ids[off]  # rolled off the base disk: gone, as in the lab
-            if len(lost):
-                d.remove_particles(lost)
-            ke = translational_energy_per_particle(d, p.density)
-            st.record(time=d.time, kinetic_energy=ke, cylinder_z=cyl.pose[0][2], particles=len(d))
-            if out.active and d.time >= next_frame[0]:
-                frames.append(out.write(d, f"aor_{len(frames):04d}.png", window=((-half, half), (-0.1 * half, 0.995 * half))))
-                next_frame[0] += c.frame_interval
-            return False
-
-        # 1. settle the filled cylinder
-        st.advance(0.1, each=each)
-        st.advance(c.max_time, each=lambda: each() or (d.time > 0.15 and translational_energy_per_particle(d, p.density) < ke_rest))
-        density = self._bulk_density(d, p, rc, dmean)
-        # 2. lift until the cylinder's bottom is above the material, then take it away
-        top = float((d.positions[:, 2] + d.radii).max())
-        cyl.set_motion(velocity=(0.0, 0.0, c.lift_speed))
-        st.advance(c.max_time, each=lambda: each() or cyl.pose[0][2] > top + dmean)
-        cyl.set_motion(velocity=(0.0, 0.0, 0.0))
-        lift_end = d.time
-        # 3. the heap comes to rest
-        at_rest = st.advance(max(0.0, c.max_time - d.time),
-                             each=lambda: each() or (d.time > lift_end + 0.1 and translational_energy_per_particle(d, p.density) < ke_rest))
-        angle, angle_se, n_sectors = heap_angle(d.positions, d.radii, dmean)
-        res = RigResult("aor")
-        res.metrics["angle_of_repose"] = Metric(angle, angle_se, "deg", f"surface fit, {n_sectors} quadrants")
-        res.metrics["bulk_density"] = Metric(density[0], density[1], "kg/m^3", "filled cylinder, 3 slabs")
-        res.series = {k: np.asarray(v) for k, v in st.series.items()}
-        res.frames = [f for f in frames if f]
-        res.info = {"particles": c.particles, "particles_on_base": len(d), "steps": st.steps, "dt": d.dt,
-                    "simulated_time": d.time, "at_rest": bool(at_rest), "wall_seconds": st.wall_seconds(),
-                    "engine_profile": d.profile(),
-                    "seed": seed, "estimator": __doc__.split("Estimator")[1].split("Bulk density")[0].strip()}
-        return res
+        return d, cyl
 
     @staticmethod
     def _bulk_density(d, p: Params, rc: float, dmean: float) -> tuple[float, float]:

@@ -103,39 +103,71 @@ def diameters_from_table(rng: np.random.Generator, n: int, sizes, passing) -> np
 
 
 class Stepper:
-    """Steps a domain in chunks, keeping time series, frames and progress reports."""
+    """Steps a domain in chunks, keeping time series, frames and progress reports; with a
+    checkpoint (attach_checkpoint) it saves right after a chunk's steps, before the chunk's
+    callback, and a restored stepper resumes the advance it was saved in."""
 
     def __init__(self, d: Domain, progress: Progress | None = None, planned_time: float = 0.0):
         self.d, self.progress, self.planned = d, progress, planned_time
         self.t_wall0 = time.perf_counter()
+        self.wall_before = 0.0  # wall seconds of the run before its last restart
         self.steps = 0
         self.series: dict[str, list] = {}
+        self.ck = None            # (Checkpoint, state function) while checkpointing
+        self.resume_at = None     # [done, total, n_chunk] of the advance a checkpoint was saved in
 
     def record(self, **values):
         for k, v in values.items():
             self.series.setdefault(k, []).append(v)
 
+    def attach_checkpoint(self, ck, rig_state: Callable[[], dict]):
+        """Save to ck when it is due; rig_state() gives what the rig keeps beside the snapshot
+        and the stepper's own state (its protocol's variables, its outputs)."""
+        self.ck = (ck, rig_state)
+
+    def state(self) -> dict:
+        return {"series": self.series, "steps": self.steps, "wall": self.wall_seconds()}
+
+    def restore(self, state: dict):
+        self.series = {k: list(v) for k, v in state["series"].items()}
+        self.steps, self.wall_before = state["steps"], state["wall"]
+        self.resume_at = state.get("advance")
+
     def advance(self, seconds: float, chunk: float = 2e-3, each: Callable[[], bool] | None = None) -> bool:
         """Steps `seconds` of simulated time in chunks; `each` is called after every chunk and
         may stop early by returning True (returns True then)."""
-        dt = self.d.dt
-        n_chunk = max(1, int(round(chunk / dt)))
-        total = int(round(seconds / dt))
-        done = 0
+        n_chunk = max(1, int(round(chunk / self.d.dt)))
+        total = int(round(seconds / self.d.dt))
+        done, resumed = 0, False
+        if self.resume_at is not None:  # the advance a checkpoint was saved in: its chunk's callback is next
+            done, total, n_chunk = self.resume_at
+            self.resume_at, resumed = None, True
         while done < total:
-            k = min(n_chunk, total - done)
-            self.d.step(k)
-            done += k
-            self.steps += k
+            if resumed:
+                resumed = False
+            else:
+                k = min(n_chunk, total - done)
+                self.d.step(k)
+                done += k
+                self.steps += k
+                if self.ck is not None and self.ck[0].due(self.d.time):
+                    self._save(done, total, n_chunk)
             if self.progress is not None:
                 self.progress(self.d.time, self.planned, {"steps": self.steps, "particles": len(self.d), "threads": self.d.num_threads,
-                                                          "wall": time.perf_counter() - self.t_wall0})
+                                                          "wall": self.wall_seconds()})
             if each is not None and each():
                 return True
         return False
 
+    def _save(self, done: int, total: int, n_chunk: int):
+        from .checkpoint import CheckpointStop
+        ck, rig_state = self.ck
+        ck.save(self.d, dict(rig_state(), stepper=dict(self.state(), advance=[done, total, n_chunk])))
+        if ck.stopping(self.d.time):
+            raise CheckpointStop(f"checkpoint at t = {self.d.time:.4g} s in {ck.dir}")
+
     def wall_seconds(self) -> float:
-        return time.perf_counter() - self.t_wall0
+        return self.wall_before + time.perf_counter() - self.t_wall0
 
 
 def translational_energy_per_particle(d: Domain, density: float) -> float:
@@ -158,6 +190,14 @@ class Frames:
         from ..vtk import VtkSeries
         self.vtk = VtkSeries(vtk_dir) if vtk_dir else None
         self.images = [] if images else None  # centre-cropped grey frames kept in memory (pydem.frames)
+
+    def state(self) -> dict:
+        """What a checkpoint keeps of the output (the VTK collections written so far)."""
+        return {"vtk": self.vtk.entries if self.vtk is not None else {}}
+
+    def restore(self, state: dict):
+        if self.vtk is not None:
+            self.vtk.entries = {k: [tuple(e) for e in v] for k, v in state.get("vtk", {}).items()}
 
     @property
     def active(self) -> bool:

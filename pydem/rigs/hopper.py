@@ -21,7 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
-from .common import Frames, Stepper, make_domain, params_from, stable_dt, translational_energy_per_particle
+from ..domain import Domain
+from ..walls import MeshWall
+from .checkpoint import Checkpoint, CheckpointStop, signature
+from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, stable_dt, translational_energy_per_particle
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult
 
@@ -61,6 +64,8 @@ class HopperConfig:
     particles: int = knob(2000, 10, 2_000_000, "", "number of spheres N")
     d_small: float = knob(6e-3, 1e-4, 0.1, "m", "fine sphere diameter")
     d_large: float = knob(9e-3, 1e-4, 0.1, "m", "coarse sphere diameter")
+    psd_sizes: list = knob([], 1e-6, 1.0, "m", "size table: sieve sizes, increasing (replaces the two species; packing A)")
+    psd_passing: list = knob([], 0.0, 1.0, "", "size table: cumulative mass fraction passing each size, 0 ... 1")
     fine_fraction: float = knob(0.3, 0.0, 1.0, "", "volume fraction of fine spheres (Phi_s)")
     packing: str = knob("A", doc="initial packing: A mixed, B1-B4 layered", choices=PACKINGS)
     top_width: float = knob(0.2, 0.01, 5.0, "m", "width of the vertical section")
@@ -82,6 +87,11 @@ class HopperConfig:
     def __post_init__(self):
         if self.case:
             apply_case(self, self.case)
+
+    @property
+    def largest(self) -> float:
+        """The largest sphere diameter: the coarse species', or the size table's top size."""
+        return max(self.d_small, self.d_large, *(self.psd_sizes[-1:] or []))
 
     def on_set(self, key: str):
         """Setting `case` loads its Table 1 values; keys set after it override them."""
@@ -149,45 +159,48 @@ class Hopper:
 
     # ---- the run ------------------------------------------------------------------------------
     def run(self, params=None, seed: int = 0, frames_dir: str | Path | None = None, progress=None,
-            vtk_dir: str | Path | None = None, images: bool = False) -> RigResult:
+            vtk_dir: str | Path | None = None, images: bool = False, checkpoint: str | Path | None = None,
+            checkpoint_every: float = 600.0, stop_at: float | None = None) -> RigResult | None:
+        """Fill, settle, open the gate, discharge; the metrics of the module's docstring.
+
+        checkpoint / checkpoint_every / stop_at: as AngleOfRepose.run (saved during the filling,
+        the settling and the discharge; resumed bitwise). Not with images=True (those frames
+        are kept in memory, not on disk)."""
         c = self.config
         p = params_from(c.params, params)
+        if checkpoint and images:
+            raise ValueError("checkpoint: not with images=True (the cropped frames live in memory); write --frames instead")
+        ck = Checkpoint(checkpoint, "hopper", signature(self, p, seed), checkpoint_every, stop_at) if checkpoint else None
+        saved = ck.load() if ck else None
         rng = np.random.default_rng(seed)
         mesh, h_wedge, z_top = self._geometry()
-        dl = max(c.d_large, c.d_small)
+        order, diameters = self._pouring_order(rng)  # bottom first (rng's first draws); True = fine
+        n_fine, n_coarse = int(order.sum()), int((~order).sum())
+        dl = c.largest
         half = 0.5 * c.top_width + 2 * dl
-        lo, hi = (-half, 0.0, -0.25 * z_top - 4 * dl), (half, c.thickness, z_top + 2 * dl)
-        d, mp, mw = make_domain(lo, hi, p, c.num_threads, diameter=dl)
-        d.seed = seed
-        mf = d.add_material(p.youngs_modulus, p.poisson_ratio, p.density)  # the fine species, same solid
-        for a, b in ((mf, mf), (mf, mp)):
-            d.set_pair(a, b, p.restitution, p.friction, p.rolling_friction, p.rolling_model)
-        d.set_pair(mf, mw, p.wall_restitution, p.wall_friction, p.wall_rolling_friction, p.rolling_model)
-        for name, values in p.effects.items():
-            for a, b in ((mf, mf), (mf, mp)):
-                d.set_effect(a, b, name, **values)
-        d.add_mesh_wall(mesh, material=mw)
-        d.add_plane_wall(axis=1, side=1, position=0.0, material=mw)
-        d.add_plane_wall(axis=1, side=-1, position=c.thickness, material=mw)
-        gate = d.add_mesh_wall(geometry.rectangle((-0.5 * c.slot_width - dl, 0, 0), (c.slot_width + 2 * dl, 0, 0),
-                                                  (0, c.thickness, 0)), material=mw)
-        n_fine, n_coarse = species_counts(c.particles, c.d_small, c.d_large, c.fine_fraction)
-        order = self._filling_order(rng, n_fine, n_coarse)  # True = fine, bottom first
-        st = Stepper(d, progress, planned_time=c.max_time)
-        self._fill(d, rng, order, mf, mp, h_wedge, z_top, st)  # sets the time step as it pours
-        st.advance(c.settle_time)
-        density = self._bulk_density(d, p, h_wedge)
-        n_initial = len(d)
-        masses = lambda: p.density * 4 / 3 * math.pi * d.radii ** 3  # noqa: E731
-
-        # discharge: the gate drops away; spheres below the slot leave the count and the domain
-        t0 = d.time
-        gate.set_motion(velocity=(0.0, 0.0, -2.0))
-        frames, next_frame, last_out = [], [t0], [t0, n_initial]
+        lo = (-half, 0.0, -0.25 * z_top - 4 * dl)
         out = Frames(frames_dir, vtk_dir, images)  # images: seed 001's crop/grey frames in memory
+        if saved:
+            d = Domain.from_snapshot(saved["snapshot"])
+            d.num_threads = c.num_threads
+            gate = MeshWall(d, 1)
+            s = saved["protocol"]
+            rng.bit_generator.state = s["rng"]
+            out.restore(saved["frames"])
+        else:
+            d, gate = self._build(p, seed, mesh, lo, z_top)
+            s = {"phase": "fill", "placed": 0, "batch_pending": False, "frames": []}
+        mp, mf = 0, 2  # the coarse and the fine species' materials (_build)
+        st = Stepper(d, progress, planned_time=c.max_time)
+        if saved:
+            st.restore(saved["stepper"])
+        if ck:
+            st.attach_checkpoint(ck, lambda: {"protocol": dict(s, rng=rng.bit_generator.state), "frames": out.state()})
+        resumed_at = d.time if saved else None
+        masses = lambda: p.density * 4 / 3 * math.pi * d.radii ** 3  # noqa: E731
         win = self._window(h_wedge, z_top)
 
-        def each():
+        def each():  # during the discharge: the gate drops away; spheres below the slot leave the count and the domain
             if gate.pose[0][2] < lo[2] + 2 * dl:
                 gate.set_motion(velocity=(0.0, 0.0, 0.0))
             z = d.positions[:, 2]
@@ -197,16 +210,32 @@ class Hopper:
             z = d.positions[:, 2]
             inside = z > 0.0
             n_r = int(inside.sum())
-            st.record(time=d.time - t0, remaining=n_r, remaining_mass=float(masses()[inside].sum()))
-            if n_r < last_out[1]:
-                last_out[:] = [d.time, n_r]
-            if out.active and d.time >= next_frame[0]:
-                frames.append((out.write(d, f"frame_{len(frames):05d}.png", width=c.frame_width,
-                                     height=c.frame_height, window=win, color="grey"), d.time - t0, n_r / n_initial))
-                next_frame[0] += c.frame_interval
-            return n_r == 0 or d.time - last_out[0] > c.jam_time
+            st.record(time=d.time - s["t0"], remaining=n_r, remaining_mass=float(masses()[inside].sum()))
+            if n_r < s["last_out"][1]:
+                s["last_out"] = [d.time, n_r]
+            if out.active and d.time >= s["next_frame"]:
+                s["frames"].append((out.write(d, f"frame_{len(s['frames']):05d}.png", width=c.frame_width,
+                                              height=c.frame_height, window=win, color="grey"),
+                                    d.time - s["t0"], n_r / s["n_initial"]))
+                s["next_frame"] += c.frame_interval
+            return n_r == 0 or d.time - s["last_out"][0] > c.jam_time
 
-        st.advance(c.max_time, chunk=5e-3, each=each)
+        try:
+            if s["phase"] == "fill":
+                self._fill(d, rng, order, diameters, mf, mp, h_wedge, z_top, st, s)  # sets the time step as it pours
+                s["phase"] = "settle"
+            if s["phase"] == "settle":
+                st.advance(c.settle_time)
+                s["density"] = list(self._bulk_density(d, p, h_wedge))
+                s["n_initial"] = len(d)
+                s["t0"] = d.time
+                gate.set_motion(velocity=(0.0, 0.0, -2.0))
+                s.update(next_frame=d.time, last_out=[d.time, len(d)], phase="discharge")
+            st.advance(c.max_time, chunk=5e-3, each=each)
+        except CheckpointStop:
+            return None
+        n_initial, density = s["n_initial"], s["density"]
+        frames = [tuple(f) for f in s["frames"]]
         series = {k: np.asarray(v) for k, v in st.series.items()}
         t, nr, mr = series["time"], series["remaining"], series["remaining_mass"]
         emptied = bool(nr[-1] == 0)
@@ -226,10 +255,49 @@ class Hopper:
             res.series["frame_nrrp"] = np.array([q for _, _, q in frames])  # without PNGs (VTK only) there is nothing to label
         res.info = {"particles": n_initial, "fine": n_fine, "coarse": n_coarse, "case": c.case, "packing": c.packing,
                     "steps": st.steps, "dt": d.dt, "simulated_time": d.time, "emptied": emptied,
-                    "engine_profile": d.profile(),
+                    "engine_profile": d.profile(), "resumed_at": resumed_at,
                     "wall_seconds": st.wall_seconds(), "seed": seed, "slot_width": c.slot_width,
                     "thickness": c.thickness}
+        if ck:
+            ck.remove()
         return res
+
+    def _build(self, p: Params, seed: int, mesh, lo, z_top):
+        """The empty hopper with its gate closed: (domain, the gate wall). Materials: 0 the
+        coarse species, 1 the walls, 2 the fine species (same solid)."""
+        c = self.config
+        dl = c.largest
+        hi = (-lo[0], c.thickness, z_top + 2 * dl)
+        d, mp, mw = make_domain(lo, hi, p, c.num_threads, diameter=dl)
+        d.seed = seed
+        mf = d.add_material(p.youngs_modulus, p.poisson_ratio, p.density)  # the fine species, same solid
+        assert (mp, mw, mf) == (0, 1, 2)
+        for a, b in ((mf, mf), (mf, mp)):
+            d.set_pair(a, b, p.restitution, p.friction, p.rolling_friction, p.rolling_model)
+        d.set_pair(mf, mw, p.wall_restitution, p.wall_friction, p.wall_rolling_friction, p.rolling_model)
+        for name, values in p.effects.items():
+            for a, b in ((mf, mf), (mf, mp)):
+                d.set_effect(a, b, name, **values)
+        d.add_mesh_wall(mesh, material=mw)
+        d.add_plane_wall(axis=1, side=1, position=0.0, material=mw)
+        d.add_plane_wall(axis=1, side=-1, position=c.thickness, material=mw)
+        gate = d.add_mesh_wall(geometry.rectangle((-0.5 * c.slot_width - dl, 0, 0), (c.slot_width + 2 * dl, 0, 0),
+                                                  (0, c.thickness, 0)), material=mw)
+        return d, gate
+
+    def _pouring_order(self, rng) -> tuple[np.ndarray, np.ndarray]:
+        """(fine?, diameter) of every sphere, bottom first: the two species in the packing's
+        order, or, given a size table, diameters drawn from it (mixed: packing A; "fine" means
+        below the table's middle size, for the counts only)."""
+        c = self.config
+        if len(c.psd_sizes) or len(c.psd_passing):
+            if c.packing != "A":
+                raise ValueError(f"a size table fills the hopper mixed (packing A), not {c.packing}: layers need two species")
+            diam = diameters_from_table(rng, c.particles, c.psd_sizes, c.psd_passing)
+            return diam < 0.5 * (c.psd_sizes[0] + c.psd_sizes[-1]), diam
+        n_fine, n_coarse = species_counts(c.particles, c.d_small, c.d_large, c.fine_fraction)
+        order = self._filling_order(rng, n_fine, n_coarse)
+        return order, np.where(order, c.d_small, c.d_large)
 
     def _filling_order(self, rng, n_fine: int, n_coarse: int) -> np.ndarray:
         fine, coarse = np.ones(n_fine, bool), np.zeros(n_coarse, bool)
@@ -248,45 +316,56 @@ class Hopper:
         h = n_coarse // 2  # B4
         return np.concatenate([coarse[:h], fine, coarse[h:]])
 
-    def _fill(self, d, rng, order, mf, mp, h_wedge, z_top, st):
+    def _fill(self, d, rng, order, diameters, mf, mp, h_wedge, z_top, st, s: dict):
         """Pours the spheres in batches: each batch fills the free space above the bed on a
-        lattice of the coarse spacing, in the given bottom-to-top order, then settles a little."""
+        lattice of the coarse spacing, in the given bottom-to-top order, then settles a little.
+        s["placed"] counts the spheres poured; s["batch_pending"]: the last batch is still
+        settling (a checkpoint inside its settling resumes there)."""
         c = self.config
-        dl = max(c.d_large, c.d_small)
+        dl = c.largest
         spacing = 1.05 * dl
-        placed = 0
-        while placed < len(order):
-            # lattice centres start 0.55 spacing above the highest sphere top: clear of it
-            # whatever the jitter (0.58 dl >= r_new + 2 % jitter)
-            bed = float((d.positions[:, 2] + d.radii).max()) + 0.55 * spacing if len(d) else 0.0
-            g = np.stack(np.meshgrid(np.arange(-0.5 * c.top_width + 0.5 * spacing, 0.5 * c.top_width, spacing),
-                                     np.arange(0.5 * spacing, c.thickness - 0.49 * spacing, spacing),
-                                     np.arange(max(bed, 0.5 * spacing), z_top - 0.5 * spacing, spacing), indexing="ij"),
-                         -1).reshape(-1, 3)
-            if len(g) == 0 or c.thickness < spacing:
-                raise ValueError(f"the hopper cannot hold {len(order)} spheres of {dl * 1e3:g} mm: "
-                                 f"{placed} placed (thickness {c.thickness * 1e3:g} mm)")
-            g = g[np.lexsort((g[:, 0], g[:, 1], g[:, 2]))]
-            g = g[self._inside(g, h_wedge, 0.55 * spacing)]
-            g = g[: len(order) - placed]
-            if len(g) == 0:
-                raise ValueError(f"the hopper is full after {placed} of {len(order)} spheres: enlarge it")
-            g += rng.uniform(-0.02, 0.02, g.shape) * spacing
-            fine = order[placed:placed + len(g)]
-            radii = np.where(fine, 0.5 * c.d_small, 0.5 * c.d_large)
-            d.add_particles(g, radii, np.where(fine, mf, mp))
-            placed += len(g)
-            # each batch may bring the smaller species first (B2, B4): the step follows
-            d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
-            st.advance(0.15 if placed < len(order) else 0.0)
+        while s["placed"] < len(order) or s["batch_pending"]:
+            if not s["batch_pending"]:
+                self._pour_batch(d, rng, order, diameters, mf, mp, h_wedge, z_top, s)
+                s["batch_pending"] = True
+            st.advance(0.15 if s["placed"] < len(order) else 0.0)
+            s["batch_pending"] = False
+
+    def _pour_batch(self, d, rng, order, diameters, mf, mp, h_wedge, z_top, s: dict):
+        c = self.config
+        dl = c.largest
+        spacing = 1.05 * dl
+        placed = s["placed"]
+        # lattice centres start 0.55 spacing above the highest sphere top: clear of it
+        # whatever the jitter (0.58 dl >= r_new + 2 % jitter)
+        bed = float((d.positions[:, 2] + d.radii).max()) + 0.55 * spacing if len(d) else 0.0
+        g = np.stack(np.meshgrid(np.arange(-0.5 * c.top_width + 0.5 * spacing, 0.5 * c.top_width, spacing),
+                                 np.arange(0.5 * spacing, c.thickness - 0.49 * spacing, spacing),
+                                 np.arange(max(bed, 0.5 * spacing), z_top - 0.5 * spacing, spacing), indexing="ij"),
+                     -1).reshape(-1, 3)
+        if len(g) == 0 or c.thickness < spacing:
+            raise ValueError(f"the hopper cannot hold {len(order)} spheres of {dl * 1e3:g} mm: "
+                             f"{placed} placed (thickness {c.thickness * 1e3:g} mm)")
+        g = g[np.lexsort((g[:, 0], g[:, 1], g[:, 2]))]
+        g = g[self._inside(g, h_wedge, 0.55 * spacing)]
+        g = g[: len(order) - placed]
+        if len(g) == 0:
+            raise ValueError(f"the hopper is full after {placed} of {len(order)} spheres: enlarge it")
+        g += rng.uniform(-0.02, 0.02, g.shape) * spacing
+        fine = order[placed:placed + len(g)]
+        radii = 0.5 * diameters[placed:placed + len(g)]
+        d.add_particles(g, radii, np.where(fine, mf, mp))
+        s["placed"] = placed + len(g)
+        # each batch may bring the smaller species first (B2, B4): the step follows
+        d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
 
     def _bulk_density(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
         c = self.config
         top = float(d.positions[:, 2].max())
-        z0, z1 = max(h_wedge, 0.3 * top), top - 2 * c.d_large
-        if z1 - z0 < 2 * c.d_large:
+        z0, z1 = max(h_wedge, 0.3 * top), top - 2 * c.largest
+        if z1 - z0 < 2 * c.largest:
             z0, z1 = 0.2 * top, 0.8 * top
-        half = 0.5 * (c.top_width if z0 >= h_wedge else c.slot_width) - c.d_large
+        half = 0.5 * (c.top_width if z0 >= h_wedge else c.slot_width) - c.largest
         fr = []
         for a, b in zip(np.linspace(z0, z1, 4)[:-1], np.linspace(z0, z1, 4)[1:]):
             s = d.region_stress("box", lo=(-half, 0.0, a), hi=(half, c.thickness, b))

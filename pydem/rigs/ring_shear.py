@@ -18,16 +18,14 @@ Steady flow: the mean shear stress of the last two quarters of a pre-shear diffe
 than `steady_tolerance` (else it continues, up to `max_preshear`)."""
 from __future__ import annotations
 
-import json
 import math
-import os
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .. import geometry
+from .checkpoint import Checkpoint, signature
 from .common import Frames, Stepper, lattice_fill, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
 from . import yield_locus as locus
@@ -108,14 +106,14 @@ class RingShear:
         split across batch jobs."""
         c = self.config
         p = params_from(c.params, params)
-        ck = Checkpoint(checkpoint, self._signature(p, seed)) if checkpoint else None
-        state = ck.load() if ck else None
-        t = Tester(c, p, seed, Frames(frames_dir, vtk_dir), progress, self._planned_time(), resume=state)
+        ck = Checkpoint(checkpoint, "ring_shear", signature(self, p, seed), every=checkpoint_every) if checkpoint else None
+        saved = ck.load() if ck else None
+        state = saved["protocol"] if saved else None
+        t = Tester(c, p, seed, Frames(frames_dir, vtk_dir), progress, self._planned_time(), resume=saved)
         steady = [tuple(np.asarray(a) for a in part) for part in state["steady"]] if state else []
         points = [tuple(q) for q in state["points"]] if state else []
         plan = self._plan()
         k0 = state["phase"] if state else 0
-        last_save = time.perf_counter()
         for k in range(k0, len(plan)):
             kind, arg = plan[k]
             if kind == "load":
@@ -126,9 +124,11 @@ class RingShear:
                 tau_sh, sigma_sh = t.shear_to_failure()
                 points.append((arg, sigma_sh, tau_sh))
             stop = max_phases is not None and k + 1 - k0 >= max_phases and k + 1 < len(plan)
-            if ck and (stop or time.perf_counter() - last_save >= checkpoint_every) and k + 1 < len(plan):
-                ck.save(t, k + 1, steady, points)
-                last_save = time.perf_counter()
+            # at a phase boundary only: the lid's mean-force accumulator is not in snapshots (it
+            # was just reset by the phase's last sample), and a phase ends right after a step
+            if ck and (stop or ck.due(t.d.time)) and k + 1 < len(plan):
+                ck.save(t.d, {"protocol": t.protocol_state(k + 1, steady, points), "stepper": t.st.state(),
+                              "frames": t.out.state()})
             if stop:
                 return None
         res = RigResult("ring-shear")
@@ -161,13 +161,6 @@ class RingShear:
                      ("load", (c.preshear_stress, 0.5))]
         return plan
 
-    def _signature(self, p: Params, seed: int) -> str:
-        """What a checkpoint must match to be resumed: the configuration, the parameters, the seed."""
-        from .config import describe
-        cfg = {k: v if isinstance(v, (int, float, str, bool)) else str(v) for k, v, _, _ in describe(self.config)
-               if k != "num_threads"}
-        return json.dumps({"config": cfg, "params": str(p), "seed": seed, "protocol": self.protocol}, sort_keys=True)
-
     def _planned_time(self) -> float:
         c = self.config
         cycles = len(c.shear_points) * c.shear_repeats
@@ -189,19 +182,20 @@ class Tester:
         self.area = math.pi * (ro ** 2 - ri ** 2)
         self.moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
         self.omega = c.shear_speed / (0.5 * (ri + ro))
-        if resume is not None:  # the state of a checkpoint (Checkpoint.load): no filling, no settling
+        if resume is not None:  # a checkpoint (Checkpoint.load): no filling, no settling
             from ..domain import Domain
             from ..walls import MeshWall
+            state = resume["protocol"]
             self.d = Domain.from_snapshot(resume["snapshot"])
             self.d.num_threads = c.num_threads
             self.trough, self.lid = MeshWall(self.d, 0), MeshWall(self.d, 1)
             self.lid.reset_mean_force()  # as the phase's last sample left it: averaging, from zero (not in snapshots)
-            self.height, self.lid_z0 = resume["height"], resume["lid_z0"]
+            self.height, self.lid_z0 = state["height"], state["lid_z0"]
             self.st = Stepper(self.d, progress, planned_time=planned_time)
-            self.st.series = {k: list(v) for k, v in resume["series"].items()}
-            self.st.steps = resume["steps"]
-            self.frames, self.next_frame, self.phase_log = resume["frames"], resume["next_frame"], resume["phase_log"]
-            self.trough_moving = resume["trough_moving"]
+            self.st.restore(resume["stepper"])
+            out.restore(resume["frames"])
+            self.frames, self.next_frame, self.phase_log = state["frames"], state["next_frame"], state["phase_log"]
+            self.trough_moving = state["trough_moving"]
             return
         radii = size_distribution(rng, c.particles, dm, c.size_spread, c.psd_sizes, c.psd_passing)
         spacing = 1.05 * 2 * radii.max()
@@ -239,6 +233,12 @@ class Tester:
         self.lid.reset_mean_force()
         self.frames, self.next_frame, self.phase_log = [], 0.0, []
         self.trough_moving = False
+
+    def protocol_state(self, phase: int, steady, points) -> dict:
+        """What a checkpoint at the start of `phase` keeps besides the snapshot and the series."""
+        return {"phase": phase, "height": self.height, "lid_z0": float(self.lid_z0), "frames": self.frames,
+                "next_frame": self.next_frame, "phase_log": self.phase_log, "trough_moving": self.trough_moving,
+                "steady": [[np.asarray(a).tolist() for a in part] for part in steady], "points": [list(q) for q in points]}
 
     def lid_state(self) -> tuple[float, float]:
         """Lid stresses averaged over the steps since the previous sample (a snapshot rattles
@@ -331,47 +331,6 @@ class Tester:
         taus = np.array(st.series["tau"][start:])
         self.phase_log.append(("shear", (d.time - t_start) * c.shear_speed))
         return float(taus.max()), float(np.array(st.series["sigma"][start:])[np.argmax(taus)])
-
-
-class Checkpoint:
-    """A ring-shear run's state at a phase boundary: <dir>/ring_shear.h5 (the domain's snapshot:
-    bitwise restart) and <dir>/ring_shear.json (the protocol's state and the signature of the
-    configuration, parameters and seed it belongs to). The JSON is written last, by rename: a
-    checkpoint exists only once both are complete. A phase ends right after a step (valid forces,
-    Tester.stop_trough) and a sample (the lid's mean-force accumulator just reset), so the
-    snapshot changes nothing and nothing else needs saving."""
-
-    def __init__(self, directory, signature: str):
-        self.dir = Path(directory)
-        self.signature = signature
-        self.snapshot, self.state = self.dir / "ring_shear.h5", self.dir / "ring_shear.json"
-
-    def load(self) -> dict | None:
-        if not self.state.exists():
-            return None
-        state = json.loads(self.state.read_text())
-        if state.get("signature") != self.signature:
-            raise ValueError(f"{self.state}: a checkpoint of another configuration, parameter set or seed "
-                             f"(remove it, or resume with the settings that made it)")
-        state["snapshot"] = str(self.snapshot)
-        return state
-
-    def save(self, t: "Tester", phase: int, steady, points):
-        self.dir.mkdir(parents=True, exist_ok=True)
-        tmp = self.dir / ".ring_shear.h5.tmp"
-        t.d.write_snapshot(tmp)
-        os.replace(tmp, self.snapshot)
-        state = {"signature": self.signature, "phase": phase, "height": t.height, "lid_z0": float(t.lid_z0),
-                 "series": t.st.series, "steps": t.st.steps, "frames": t.frames, "next_frame": t.next_frame,
-                 "phase_log": t.phase_log, "trough_moving": t.trough_moving, "steady": [[np.asarray(a).tolist() for a in part] for part in steady],
-                 "points": [list(q) for q in points]}
-        tmp = self.dir / ".ring_shear.json.tmp"
-        tmp.write_text(json.dumps(state))
-        os.replace(tmp, self.state)
-
-    def remove(self):
-        for f in (self.state, self.snapshot):
-            f.unlink(missing_ok=True)
 
 
 def preshear_metrics(steady: list[tuple[np.ndarray, np.ndarray, np.ndarray]], metrics: dict) -> tuple[float, float, float]:

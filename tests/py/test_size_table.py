@@ -45,3 +45,12 @@ def test_a_rig_fills_from_the_table(tmp_path):
     cls(cfg).run(seed=1, vtk_dir=tmp_path)
     r = meshio.read(tmp_path / "particles_00000.vtu").point_data["radius"]
     assert len(r) == 150 and r.min() >= 1e-3 and r.max() <= 2e-3 and r.max() - r.min() > 0.5e-3
+
+
+def test_the_hopper_fills_from_the_table_and_refuses_layers():
+    cls, cfg_cls = RIGS["hopper"]
+    table = ["psd_sizes=[3e-3,4e-3,6e-3]", "psd_passing=[0,0.3,1]", "max_time=0.1", "settle_time=0.0"]
+    res = cls(load(cfg_cls, "tiny", None, table)).run(seed=2)
+    assert res.info["particles"] == 250 and res.info["fine"] + res.info["coarse"] == 250
+    with pytest.raises(ValueError, match="packing A"):
+        cls(load(cfg_cls, "tiny", None, table + ["packing=B1"])).run(seed=2)
