@@ -108,16 +108,39 @@ def _fill(obs: list[Observation], values: dict, nets: dict, rng: np.random.Gener
     return out
 
 
-def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
-                  obs: list[Observation]) -> list[Observation]:
-    """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
+def surrogate_values(nets: dict, candidates: list[Candidate], truth: Truth, obs: list[Observation]) -> dict[int, float]:
+    """The nets' values at the truth for every observation (no scatter, no noise)."""
     inp = truth.inputs(candidates)
     values = {}
     for i, o in enumerate(obs):
         net = nets[o.quantity]
         x = np.array([[o.conditions.get(n, inp.get(n, math.nan)) for n in net.input_names]])
-        values[i] = float(net(x)[0]) + rng.normal(0.0, net.seed_sd)
+        values[i] = float(net(x)[0])
+    return values
+
+
+def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
+                  obs: list[Observation]) -> list[Observation]:
+    """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
+    values = surrogate_values(nets, candidates, truth, obs)
+    values = {i: v + rng.normal(0.0, nets[o.quantity].seed_sd) for (i, v), o in zip(values.items(), obs)}
     return _fill(obs, values, nets, rng)
+
+
+def signal(setup, truth: Truth, obs: list[Observation]) -> float:
+    """How visible the hidden effect is in a set, whatever the method: chi^2 of the base model's
+    best fit to the set's noise-free values (the truth's net values, each row with the set's
+    uncertainty). It is the noncentrality of the likelihood-ratio test of the true effect: the
+    statistic scatters about it by the noise (noncentral chi^2_1), so an effect whose signal is
+    below the test's critical value (6.6 at p = 0.01) is missed as often as it is found by any
+    method on these measurements; 0 for a null set."""
+    from .calibrate import fit_base
+    if truth.effect is None:
+        return 0.0
+    values = surrogate_values(setup.nets, setup.candidates, truth, obs)
+    clean = [Observation(o.quantity, dict(o.conditions), values[i], o.uncertainty, o.label) for i, o in enumerate(obs)]
+    _, fit = fit_base(clean, setup.nets, setup.ranges, setup.candidates)
+    return float(fit.chi2)
 
 
 def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], seed: int, threads: int = 1,
@@ -195,6 +218,10 @@ def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]
     return out
 
 
+SIGNAL_VISIBLE = 15.0  # the noncentrality at which the one-sided LR test at p = 0.01 has 94 % power
+SIGNAL_BINS = ((0.0, 5.0), (5.0, 15.0), (15.0, 50.0), (50.0, math.inf))
+
+
 def score_sets(results: list[dict]) -> dict:
     """Accuracy, false alarms and error fall over validation results (rows of `validate`)."""
     by = {}
@@ -211,7 +238,13 @@ def score_sets(results: list[dict]) -> dict:
         else:
             hit = [r for r in rows if r["effect"] == kind]
             falls = [r["rmse_after"] / r["rmse_before"] for r in hit if r["rmse_after"] is not None and r["rmse_before"] > 0]
+            seen = [r for r in rows if (r.get("signal") or 0.0) >= SIGNAL_VISIBLE]
             out[kind] = {"sets": n, "top1": len(hit), "top1_rate": len(hit) / n,
+                         "visible_sets": len(seen), "top1_visible": sum(r["effect"] == kind for r in seen),
+                         "top1_rate_visible": sum(r["effect"] == kind for r in seen) / len(seen) if seen else None,
+                         "by_signal": {f"{lo:g}-{hi:g}": [sum(r["effect"] == kind for r in b), len(b)]
+                                       for lo, hi in SIGNAL_BINS
+                                       for b in [[r for r in rows if r.get("signal") is not None and lo <= r["signal"] < hi]]},
                          "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})},
                          "error_after_over_before_median": float(np.median(falls)) if falls else None,
                          "chi2_per_dof_after_median": float(np.median([r["chi2_after"] for r in hit])) if hit else None}
@@ -248,10 +281,11 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                 obs = surrogate_set(setup.nets, setup.candidates, truth, rng, base_obs)
             if kind == "unexplained":
                 obs = density_mismatch(obs, 1.25)
+            visible = signal(setup, truth, obs) if source == "surrogate" else None
             d = diagnose(f"{kind}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
             s_before, s_after = d.summary_of(d.base, d.base_model), d.summary_of(d.after, d.after_model)
             row = {"kind": kind, "set": k, "source": source, "truth": truth.theta, "effect_truth": truth.effect,
-                   "strength": truth.strength, "verdict": d.verdict, "effect": d.effect,
+                   "strength": truth.strength, "signal": visible, "verdict": d.verdict, "effect": d.effect,
                    "best_candidate": d.candidates[0].effect if d.candidates else None,
                    "p_best": d.candidates[0].p_value if d.candidates else None,
                    "chi2_before": s_before["chi2_per_dof"], "rmse_before": s_before["rmse_relative"],
