@@ -1,0 +1,224 @@
+"""Training and judging seed 001's image networks on a frame store (pydem.frames.FrameStore),
+beside the physics baselines.
+
+- `load_frames`: every stored frame of the chosen cases as float32 (n, 1, size, size) in [0, 1]
+  (area-averaged from the stored 224 x 224 crop when size < 224) with its case, time,
+  remaining discharge time and NRRP;
+- splits: `random_split` (seed 001's 60/20/20 over frames: neighbouring frames of one run are
+  near-duplicates, so it flatters) and `case_split` (whole cases held out: what a user predicting
+  a new hopper gets);
+- `fit`: Adam on standardised targets, mini-batches, the weights of the best validation loss
+  kept; seeded, with progress (epoch, loss, frames/s, time left) and a checkpoint after every
+  epoch from which a killed training resumes;
+- `scores`: MAE, RMSE, R^2 (seed 001, Eqs. 7-9) and the average relative error (Eq. 10);
+- baselines: Beverloo's slot law for a case's discharge time (C and k fitted on training cases
+  only) and, per frame, the remaining time as the frame's fill fraction times it; a constant-rate
+  extrapolation of the first 20 % of NRRP(t)."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+
+@dataclass
+class Frames:
+    x: np.ndarray          # (n, 1, size, size) float32 in [0, 1]
+    case: np.ndarray       # (n,) case names
+    time: np.ndarray       # s since the gate opened
+    remaining: np.ndarray  # remaining discharge time (s)
+    nrrp: np.ndarray
+    discharge: dict        # case -> discharge time (s)
+    attrs: dict            # case -> stored attributes
+
+    def take(self, idx) -> "Frames":
+        return Frames(self.x[idx], self.case[idx], self.time[idx], self.remaining[idx], self.nrrp[idx],
+                      self.discharge, self.attrs)
+
+
+def shrink(frames: np.ndarray, size: int) -> np.ndarray:
+    """uint8 (n, H, W) -> float32 (n, 1, size, size) in [0, 1], area-averaged."""
+    x = torch.from_numpy(np.asarray(frames, np.float32) / 255.0)[:, None]
+    if size != x.shape[-1]:
+        x = torch.nn.functional.adaptive_avg_pool2d(x, size)
+    return x.numpy()
+
+
+def load_frames(store_path, cases=None, size: int = 224, every: int = 1) -> Frames:
+    """Every `every`-th frame of each case (all stored cases when cases is None), in time order."""
+    from pydem.frames import FrameStore
+    store = FrameStore(store_path)
+    names = cases or store.cases()
+    xs, cs, ts, rs, ns, dis, attrs = [], [], [], [], [], {}, {}
+    for c in names:
+        d = store.read_case(c)
+        sl = slice(None, None, every)
+        xs.append(shrink(d["frames"][sl], size))
+        cs += [c] * len(xs[-1])
+        ts.append(d["time"][sl]), rs.append(d["remaining_time"][sl]), ns.append(d["nrrp"][sl])
+        dis[c] = float(d["discharge_time"])
+        attrs[c] = {"case": c} | {k: v for k, v in d.items() if k not in ("frames", "time", "remaining_time", "nrrp")}
+    if not xs:
+        raise ValueError(f"{store_path}: no frames of the cases {names}")
+    return Frames(np.concatenate(xs), np.array(cs), np.concatenate(ts), np.concatenate(rs), np.concatenate(ns), dis, attrs)
+
+
+def random_split(n: int, seed: int = 0, fractions=(0.6, 0.2, 0.2)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(train, validation, test) frame indices, seed 001's random 60/20/20."""
+    order = np.random.default_rng(seed).permutation(n)
+    a, b = int(round(fractions[0] * n)), int(round((fractions[0] + fractions[1]) * n))
+    return np.sort(order[:a]), np.sort(order[a:b]), np.sort(order[b:])
+
+
+def case_split(case: np.ndarray, test_cases, validation_cases) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(train, validation, test) indices with whole cases held out."""
+    test, val = np.isin(case, list(test_cases)), np.isin(case, list(validation_cases))
+    if (test & val).any():
+        raise ValueError("a case cannot be both a validation and a test case")
+    return np.flatnonzero(~test & ~val), np.flatnonzero(val), np.flatnonzero(test)
+
+
+def scores(y: np.ndarray, pred: np.ndarray) -> dict:
+    """MAE, RMSE, R^2 (seed 001 Eqs. 7-9) and the average relative error |y - pred| / y (Eq. 10,
+    over the rows with y > 0)."""
+    y, pred = np.asarray(y, float), np.asarray(pred, float)
+    err = pred - y
+    pos = y > 0
+    return {"mae": float(np.mean(np.abs(err))), "rmse": float(np.sqrt(np.mean(err ** 2))),
+            "r2": float(1.0 - np.sum(err ** 2) / np.sum((y - y.mean()) ** 2)) if len(y) > 1 else math.nan,
+            "relative_error": float(np.mean(np.abs(err[pos]) / y[pos])) if pos.any() else math.nan, "n": int(len(y))}
+
+
+class Progress:
+    def __init__(self, say=print):
+        self.say = say
+
+    def __call__(self, epoch: int, epochs: int, loss: float, val: float, rate: float, left: float):
+        self.say(f"  epoch {epoch}/{epochs}  loss {loss:.4g}  validation {val:.4g}  {rate:.0f} frames/s  "
+                 f"{left / 60:.1f} min left")
+
+
+def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray, y_val: np.ndarray, epochs: int = 20,
+        batch: int = 32, lr: float = 1e-4, seed: int = 0, checkpoint: str | Path | None = None, progress=None) -> dict:
+    """Trains model (in place, initialised by the caller: seed torch before building it) to
+    predict y from x with MSE on standardised targets; keeps the weights of the best validation loss. With checkpoint (a file), the state after each epoch is
+    saved there and a rerun continues from it. Returns the history and the target scaling."""
+    torch.manual_seed(seed)
+    mean, sd = float(np.mean(y)), float(np.std(y) or 1.0)
+    xt, yt = torch.from_numpy(np.ascontiguousarray(x)), torch.from_numpy(((y - mean) / sd).astype(np.float32))
+    xv, yv = torch.from_numpy(np.ascontiguousarray(x_val)), torch.from_numpy(((y_val - mean) / sd).astype(np.float32))
+    opt = torch.optim.Adam(model.parameters(), lr=lr)
+    state = {"epoch": 0, "history": [], "best": math.inf, "best_weights": None}
+    ck = Path(checkpoint) if checkpoint else None
+    if ck is not None and ck.exists():
+        saved = torch.load(ck, weights_only=False)
+        model.load_state_dict(saved["model"])
+        opt.load_state_dict(saved["optimizer"])
+        state = saved["state"]
+        torch.set_rng_state(saved["rng"])
+    t0, seen = time.perf_counter(), 0
+    for epoch in range(state["epoch"] + 1, epochs + 1):
+        model.train()
+        order = torch.randperm(len(yt))
+        total = 0.0
+        for i in range(0, len(order), batch):
+            idx = order[i:i + batch]
+            opt.zero_grad()
+            loss = torch.mean((model(xt[idx]).reshape(yt[idx].shape) - yt[idx]) ** 2)
+            loss.backward()
+            opt.step()
+            total += float(loss.detach()) * len(idx)
+            seen += len(idx)
+        val = float(np.mean((predict_scaled(model, xv, batch) - yv.numpy().reshape(-1)) ** 2)) if len(yv) else math.nan
+        state["history"].append({"epoch": epoch, "loss": total / len(yt), "validation": val})
+        if not (val >= state["best"]):  # the first epoch, a better one, or no validation set
+            state["best"] = val
+            state["best_weights"] = {k: v.detach().clone() for k, v in model.state_dict().items()}
+        state["epoch"] = epoch
+        if ck is not None:
+            ck.parent.mkdir(parents=True, exist_ok=True)
+            tmp = ck.with_suffix(".tmp")
+            torch.save({"model": model.state_dict(), "optimizer": opt.state_dict(), "state": state,
+                        "rng": torch.get_rng_state()}, tmp)
+            tmp.replace(ck)
+        if progress is not None:
+            rate = seen / max(time.perf_counter() - t0, 1e-9)
+            progress(epoch, epochs, total / len(yt), val, rate, (epochs - epoch) * len(yt) / max(rate, 1e-9))
+    if state["best_weights"] is not None:
+        model.load_state_dict(state["best_weights"])
+    model.eval()
+    return {"history": state["history"], "mean": mean, "sd": sd}
+
+
+def windows(x: np.ndarray, y: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sliding windows of `length` consecutive frames (stride 1) for the CNN-LSTM:
+    (n - length + 1, length, 1, H, W) and their targets (n - length + 1, length)."""
+    n = len(x) - length + 1
+    if n < 1:
+        raise ValueError(f"{len(x)} frames are fewer than one window of {length}")
+    idx = np.arange(length)[None, :] + np.arange(n)[:, None]
+    return x[idx], y[idx]
+
+
+def predict_scaled(model: torch.nn.Module, x, batch: int = 64) -> np.ndarray:
+    model.eval()
+    x = torch.as_tensor(x)
+    with torch.no_grad():
+        return np.concatenate([model(x[i:i + batch]).reshape(-1).numpy() for i in range(0, len(x), batch)]) \
+            if len(x) else np.zeros(0, np.float32)
+
+
+def predict(model: torch.nn.Module, x: np.ndarray, scaling: dict, batch: int = 64) -> np.ndarray:
+    return predict_scaled(model, x, batch) * scaling["sd"] + scaling["mean"]
+
+
+# ---- physics baselines -------------------------------------------------------------------
+
+def case_mass_and_size(attrs: dict) -> tuple[float, float, float]:
+    """(total mass kg, mean diameter m, solid density) of a stored Table 1 case from its attributes."""
+    from pydem.rigs.hopper import TABLE1, species_counts
+    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[attrs["case"]]
+    ds, dl = dd[0] / 1000.0, dd[1] / 1000.0
+    nf, nc = species_counts(n, ds, dl, phi)
+    mass = rho * math.pi / 6.0 * (nf * ds ** 3 + nc * dl ** 3)
+    return mass, phi * ds + (1.0 - phi) * dl, float(rho)
+
+
+def beverloo_discharge(train: dict[str, float], attrs: dict[str, dict], slot: float = 0.054, length: float = 0.04):
+    """Beverloo's slot law W = C rho sqrt(g) L (b - k d)^(3/2) with the solid density (the packing
+    fraction goes into C), C and k fitted on the training cases' mean flow rates M / t_dis (least
+    squares in W^(2/3), a grid over k); returns (C, k, predict(case attrs) -> discharge time)."""
+    rows = [(case_mass_and_size(attrs[c]), t) for c, t in train.items()]
+    best = None
+    for k in np.linspace(0.0, 3.0, 301):
+        feats = np.array([rho * math.sqrt(9.81) * length * max(slot - k * d, 1e-6) ** 1.5 for (m, d, rho), _ in rows])
+        w = np.array([m / t for (m, d, rho), t in rows])
+        c = float(feats @ w / (feats @ feats))
+        err = float(np.sum((w ** (2 / 3) - (c * feats) ** (2 / 3)) ** 2))
+        if best is None or err < best[0]:
+            best = (err, c, float(k))
+    _, c, k = best
+
+    def discharge_time(a: dict) -> float:
+        m, d, rho = case_mass_and_size(a)
+        return m / (c * rho * math.sqrt(9.81) * length * max(slot - k * d, 1e-6) ** 1.5)
+    return c, k, discharge_time
+
+
+def fill_fraction(x: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """Each frame's particle pixels (darker than the background) over those of its case's first
+    frame: an image-only estimate of the NRRP."""
+    dark = lambda f: np.sum(f < 0.9 * np.median(f), axis=(-2, -1)).reshape(len(f))  # noqa: E731
+    return dark(x) / max(float(dark(first[None])[0]), 1.0)
+
+
+def constant_rate_nrrp(t: np.ndarray, nrrp: np.ndarray, fraction: float = 0.2) -> np.ndarray:
+    """NRRP(t) extrapolated at the constant rate of a straight line through the first `fraction`
+    of the (time-ordered) series, clipped to [0, 1]."""
+    k = max(2, int(round(fraction * len(t))))
+    slope, icpt = np.polyfit(t[:k], nrrp[:k], 1)
+    return np.clip(icpt + slope * t, 0.0, 1.0)

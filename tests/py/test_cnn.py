@@ -1,0 +1,100 @@
+"""Seed 001's image networks (nn/cnn.py) and their training and baselines (nn/images.py).
+
+The four backbones are torchvision's architectures written again in plain torch: built for
+ImageNet (3 channels, 1000 outputs) each must have exactly torchvision's published parameter
+count, which pins every layer's shape. Training must lower the loss on frames whose label a
+network can read (the dark area of a synthetic frame), resume from its checkpoint bitwise, and
+the baselines must recover the known rate / law of synthetic data."""
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from nn import cnn, images
+
+
+@pytest.mark.parametrize("name, build, count", [
+    ("AlexNet", lambda: cnn.AlexNet(3, 1000), 61_100_840),
+    ("VGG-16", lambda: cnn.VGG(16, 3, 1000), 138_357_544),
+    ("VGG-19", lambda: cnn.VGG(19, 3, 1000), 143_667_240),
+    ("ResNet-50", lambda: cnn.ResNet50(3, 1000), 25_557_032)])
+def test_backbones_have_torchvisions_parameter_counts(name, build, count):
+    assert cnn.parameter_count(build()) == count, name
+
+
+@pytest.mark.parametrize("name", sorted(cnn.BACKBONES))
+def test_backbones_regress_one_value_from_grey_frames_down_to_their_smallest_input(name):
+    m = cnn.BACKBONES[name]().eval()
+    with torch.no_grad():
+        for size in (m.min_input, 80):
+            assert m(torch.rand(2, 1, size, size)).shape == (2, 1)
+
+
+def test_cnn_lstm_is_the_seeds_architecture():
+    m = cnn.CNNLSTM().eval()
+    convs = [layer.out_channels for layer in m.cnn if isinstance(layer, torch.nn.Conv2d)]
+    assert convs == [32, 64, 128, 25]
+    assert [lstm.hidden_size for lstm in m.lstms] == [4, 8, 16, 32]
+    assert m.cnn[-2].out_features == 1024
+    with torch.no_grad():
+        assert m(torch.rand(3, 5, 1, 48, 48)).shape == (3, 5)  # an NRRP per frame of each sequence
+
+
+def blobs(n: int, size: int = 64, seed: int = 0):
+    """Light frames with a dark square whose area fraction is the label."""
+    rng = np.random.default_rng(seed)
+    x = np.ones((n, 1, size, size), np.float32)
+    side = rng.integers(4, size // 2, n)
+    for i, s in enumerate(side):
+        a, b = rng.integers(0, size - s, 2)
+        x[i, 0, a:a + s, b:b + s] = 0.1
+    return x, (side.astype(np.float32) / size) ** 2
+
+
+def test_training_lowers_the_loss_and_resumes_bitwise(tmp_path):
+    torch.set_num_threads(1)
+    x, y = blobs(160)
+    xv, yv = blobs(40, seed=1)
+    torch.manual_seed(0)  # the initial weights: the caller's
+    first = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2)
+    h = first["history"]
+    assert h[-1]["loss"] < 0.5 * h[0]["loss"], h
+    assert min(e["validation"] for e in h) < 0.5, h  # standardised: 1 is "predicts the mean"
+    # a training killed after 3 epochs and resumed from its checkpoint ends where the whole one did
+    ck = tmp_path / "fc.pt"
+    torch.manual_seed(0)
+    images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=3, batch=16, lr=3e-4, seed=2, checkpoint=ck)
+    resumed = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2, checkpoint=ck)
+    assert resumed["history"] == h
+
+
+def test_scores_by_hand():
+    s = images.scores(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 2.0]))
+    assert s["mae"] == pytest.approx(0.5) and s["rmse"] == pytest.approx(math.sqrt(1.25 / 3))
+    assert s["r2"] == pytest.approx(1 - 1.25 / 2.0) and s["relative_error"] == pytest.approx((0.25 + 1 / 3) / 3)
+
+
+def test_constant_rate_baseline_on_a_steady_discharge():
+    t = np.linspace(0.0, 2.0, 101)
+    nrrp = np.clip(1.0 - 0.6 * t, 0.0, 1.0)  # a steady discharge, empty at t = 5/3 s
+    assert np.allclose(images.constant_rate_nrrp(t, nrrp), nrrp, atol=1e-12)
+
+
+def test_beverloo_baseline_recovers_its_law():
+    from pydem.rigs.hopper import TABLE1
+    c_true, k_true = 0.58, 1.4
+    attrs = {c: {"case": c} for c in TABLE1}
+    truth = {}
+    for c, a in attrs.items():
+        m, d, rho = images.case_mass_and_size(a)
+        truth[c] = m / (c_true * rho * math.sqrt(9.81) * 0.04 * (0.054 - k_true * d) ** 1.5)
+    c, k, predict = images.beverloo_discharge({c: truth[c] for c in list(TABLE1)[:15]}, attrs)
+    assert c == pytest.approx(c_true, rel=1e-2) and k == pytest.approx(k_true, abs=0.011)  # k on a 0.01 grid
+    assert all(predict(attrs[c]) == pytest.approx(truth[c], rel=0.02) for c in list(TABLE1)[15:])
+
+
+def test_windows_for_the_sequence_model():
+    x = np.arange(6, dtype=np.float32).reshape(6, 1, 1, 1)
+    w, y = images.windows(x, np.arange(6.0), 4)
+    assert w.shape == (3, 4, 1, 1, 1) and y.tolist() == [[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]]
