@@ -231,7 +231,8 @@ class Hopper:
                 s["t0"] = d.time
                 gate.set_motion(velocity=(0.0, 0.0, -2.0))
                 s.update(next_frame=d.time, last_out=[d.time, len(d)], phase="discharge")
-            st.advance(c.max_time, chunk=5e-3, each=each)
+            # frames are taken between chunks: with frames on, chunks no longer than their interval
+            st.advance(c.max_time, chunk=min(5e-3, c.frame_interval) if out.active else 5e-3, each=each)
         except CheckpointStop:
             return None
         n_initial, density = s["n_initial"], s["density"]
