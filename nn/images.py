@@ -10,7 +10,8 @@ beside the physics baselines.
 - `fit`: Adam on standardised targets, mini-batches, the weights of the best validation loss
   kept; seeded, with progress (epoch, loss, frames/s, time left) and a checkpoint after every
   epoch from which a killed training resumes;
-- `scores`: MAE, RMSE, R^2 (seed 001, Eqs. 7-9) and the average relative error (Eq. 10);
+- `scores`: MAE, RMSE, R^2 (seed 001, Eqs. 7-9) and the average relative error (Eq. 10, away
+  from the empty end);
 - baselines: Beverloo's slot law for a case's discharge time (C and k fitted on training cases
   only) and, per frame, the remaining time as the frame's fill fraction times it; a constant-rate
   extrapolation of the first 20 % of NRRP(t)."""
@@ -82,15 +83,19 @@ def case_split(case: np.ndarray, test_cases, validation_cases) -> tuple[np.ndarr
     return np.flatnonzero(~test & ~val), np.flatnonzero(val), np.flatnonzero(test)
 
 
-def scores(y: np.ndarray, pred: np.ndarray) -> dict:
-    """MAE, RMSE, R^2 (seed 001 Eqs. 7-9) and the average relative error |y - pred| / y (Eq. 10,
-    over the rows with y > 0)."""
+def scores(y: np.ndarray, pred: np.ndarray, floor: float = 0.1) -> dict:
+    """MAE, RMSE, R^2 (seed 001 Eqs. 7-9) and the average relative error |y - pred| / y (Eq. 10)
+    over the rows with y >= floor x max(y): the remaining time and the NRRP both fall to zero at
+    the end of a discharge, where a relative error has no bound and would drown the rest."""
     y, pred = np.asarray(y, float), np.asarray(pred, float)
+    if len(y) == 0:
+        return {"mae": math.nan, "rmse": math.nan, "r2": math.nan, "relative_error": math.nan, "n": 0}
     err = pred - y
-    pos = y > 0
+    rel = y >= floor * y.max()
+    rel &= y > 0
     return {"mae": float(np.mean(np.abs(err))), "rmse": float(np.sqrt(np.mean(err ** 2))),
             "r2": float(1.0 - np.sum(err ** 2) / np.sum((y - y.mean()) ** 2)) if len(y) > 1 else math.nan,
-            "relative_error": float(np.mean(np.abs(err[pos]) / y[pos])) if pos.any() else math.nan, "n": int(len(y))}
+            "relative_error": float(np.mean(np.abs(err[rel]) / y[rel])) if rel.any() else math.nan, "n": int(len(y))}
 
 
 class Progress:

@@ -5,8 +5,11 @@ the 11 Table 1 parameters against the cases' discharge times (nn.gra), per packi
 
     .venv/bin/python -m nn.seed001 frames --store data/seed001/frames.h5 [--cases A-1 B1-3] [--frame-interval 0.02]
     .venv/bin/python -m nn.seed001 gra --store data/seed001/frames.h5
+    .venv/bin/python -m nn.seed001 subset --store data/seed001/frames_full.h5 --out data/seed001/frames_subset.h5 --every 25
+    .venv/bin/python -m nn.seed001 compare|point-to-point|process --store STORE --out DIR [--size 64 --epochs N]
 
-The frame campaign is resumable: a case is written whole when its run ends, and a rerun does
+The last three are nn.seed001_experiments (the networks beside their physics baselines; results
+as JSON in DIR). The frame campaign is resumable: a case is written whole when its run ends, and a rerun does
 only the cases the store lacks."""
 from __future__ import annotations
 
@@ -71,6 +74,17 @@ def run_frames(store_path: str, cases: list[str], frame_interval: float, threads
         say(f"  {case}: {len(res.images)} frames, discharge time {t_dis:.3f} s, {time.perf_counter() - t0:.0f} s")
 
 
+def write_subset(full: str, out: str, every: int):
+    """Every `every`-th frame of each case of `full` into the store `out` (labels and attributes kept)."""
+    from pydem.frames import FrameStore
+    src, dst = FrameStore(full), FrameStore(out)
+    for case in src.cases():
+        d = src.read_case(case)
+        attrs = {k: v for k, v in d.items() if k not in ("frames", "time", "remaining_time", "nrrp", "complete", "discharge_time")}
+        dst.write_case(case, d["frames"][::every], d["time"][::every], d["discharge_time"], d["nrrp"][::every],
+                       attrs | {"subset_every": every})
+
+
 def main(argv=None) -> int:
     from pydem.rigs.hopper import TABLE1
     ap = argparse.ArgumentParser(prog="python -m nn.seed001")
@@ -83,9 +97,37 @@ def main(argv=None) -> int:
     g = sub.add_parser("gra", help="grey relational analysis of the stored cases' discharge times")
     g.add_argument("--store", required=True)
     g.add_argument("--rho", type=float, default=0.5)
+    sb = sub.add_parser("subset", help="every N-th frame of each case into a small store")
+    sb.add_argument("--store", required=True)
+    sb.add_argument("--out", required=True)
+    sb.add_argument("--every", type=int, default=25)
+    for name, what in (("compare", "AlexNet, ResNet-50, VGG-16, VGG-19 on the remaining discharge time"),
+                       ("point-to-point", "AlexNet-FC, random-frame and leave-cases-out splits"),
+                       ("process", "the CNN-LSTM per case on NRRP(t) from its first 20 %")):
+        e = sub.add_parser(name, help=what)
+        e.add_argument("--store", required=True)
+        e.add_argument("--out", required=True, help="directory for the results JSON and the training checkpoints")
+        e.add_argument("--size", type=int, default=64, help="frame side after area-averaging the 224 x 224 crop")
+        e.add_argument("--epochs", type=int)
+        e.add_argument("--every", type=int, help="use every N-th stored frame (compare, point-to-point)")
+        e.add_argument("--seed", type=int, default=0)
+        e.add_argument("--threads", type=int, default=2, help="torch threads")
     args = ap.parse_args(argv)
     if args.cmd == "frames":
         run_frames(args.store, args.cases, args.frame_interval, args.threads)
+        return 0
+    if args.cmd == "subset":
+        write_subset(args.store, args.out, args.every)
+        return 0
+    if args.cmd in ("compare", "point-to-point", "process"):
+        import torch
+        from . import seed001_experiments as ex
+        torch.set_num_threads(args.threads)
+        kw = {k: v for k, v in (("epochs", args.epochs), ("every", args.every)) if v is not None}
+        if args.cmd == "process":
+            kw.pop("every", None)
+        run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
+        run(args.store, args.out, size=args.size, seed=args.seed, **kw)
         return 0
     from pydem.frames import FrameStore
     store = FrameStore(args.store)

@@ -73,6 +73,9 @@ def test_scores_by_hand():
     s = images.scores(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 2.0]))
     assert s["mae"] == pytest.approx(0.5) and s["rmse"] == pytest.approx(math.sqrt(1.25 / 3))
     assert s["r2"] == pytest.approx(1 - 1.25 / 2.0) and s["relative_error"] == pytest.approx((0.25 + 1 / 3) / 3)
+    # near the empty end (y below 10 % of its largest) rows count in MAE/RMSE/R^2, not in the relative error
+    s = images.scores(np.array([0.01, 1.0]), np.array([0.5, 1.5]))
+    assert s["relative_error"] == pytest.approx(0.5) and s["mae"] == pytest.approx(0.495)
 
 
 def test_constant_rate_baseline_on_a_steady_discharge():

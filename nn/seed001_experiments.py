@@ -1,0 +1,167 @@
+"""Seed 001's three learning experiments on a frame store, each beside its physics baseline
+(docs/seed001.md):
+
+- `compare`: AlexNet, ResNet-50, VGG-16, VGG-19 regress the remaining discharge time from a
+  frame; seed 001's random 60/20/20 split of the frames; MAE, RMSE, R^2 (its Table 2);
+- `point_to_point`: AlexNet-FC on two splits — random frames (the seed's protocol; neighbouring
+  frames of one run are near-duplicates, so it flatters) and leave-cases-out (whole cases held
+  out: a new hopper); R^2 and average relative error per packing pattern;
+- `process`: the CNN-LSTM per case, trained on the first 20 % of its time-ordered frames,
+  predicting NRRP over the rest; average relative error per packing pattern.
+
+Baselines: the remaining discharge time as the frame's fill fraction (image-only NRRP
+estimate) times Beverloo's discharge time (C, k fitted on the training cases); NRRP by a
+constant-rate extrapolation of the first 20 %. Every result records its settings, the time each
+training took and the machine, so the docs' tables can say what stands behind them."""
+from __future__ import annotations
+
+import json
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from . import cnn, images
+
+PACKINGS = ("A", "B1", "B2", "B3", "B4")
+
+
+def _packing(case: str) -> str:
+    return case.split("-")[0]
+
+
+def _machine() -> str:
+    import os
+    return f"{platform.machine()}, {len(os.sched_getaffinity(0))} cores, torch {torch.__version__}, {torch.get_num_threads()} threads"
+
+
+def _beverloo_per_frame(f: images.Frames, train_cases, first_frames: dict) -> tuple[np.ndarray, dict]:
+    """Remaining discharge time per frame: fill fraction x Beverloo discharge time of its case."""
+    c, k, t_dis = images.beverloo_discharge({cs: f.discharge[cs] for cs in train_cases}, f.attrs)
+    pred = np.empty(len(f.x))
+    for cs in np.unique(f.case):
+        m = f.case == cs
+        pred[m] = images.fill_fraction(f.x[m], first_frames[cs]) * t_dis(f.attrs[cs])
+    return pred, {"C": c, "k": k}
+
+
+def _first_frames(store, size: int) -> dict:
+    from pydem.frames import FrameStore
+    s = FrameStore(store)
+    return {c: images.shrink(s.read_case(c)["frames"][:1], size)[0] for c in s.cases()}
+
+
+def _train(name: str, build, f: images.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say):
+    torch.manual_seed(seed)
+    model = build()
+    t0 = time.perf_counter()
+    scaling = images.fit(model, f.x[tr], f.remaining[tr], f.x[va], f.remaining[va], epochs=epochs, batch=batch, lr=lr,
+                         seed=seed, checkpoint=out / f"{name}.pt", progress=images.Progress(say))
+    seconds = time.perf_counter() - t0
+    return model, scaling, seconds
+
+
+def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: int = 32, lr: float = 1e-4,
+            models=tuple(cnn.BACKBONES), seed: int = 0, say=print) -> dict:
+    out = Path(out)
+    f = images.load_frames(store, size=size, every=every)
+    tr, va, te = images.random_split(len(f.x), seed)
+    say(f"compare: {len(f.x)} frames of {len(f.discharge)} cases at {size} x {size}; train {len(tr)}, validation {len(va)}, test {len(te)}")
+    res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
+                        "frames": int(len(f.x)), "split": "random 60/20/20 over frames"}, "machine": _machine(), "models": {}}
+    for name in models:
+        say(f"- {name}")
+        model, scaling, seconds = _train(name, cnn.BACKBONES[name], f, tr, va, epochs, batch, lr, seed, out, say)
+        t0 = time.perf_counter()
+        pred = images.predict(model, f.x[te], scaling)
+        per_frame = (time.perf_counter() - t0) / max(len(te), 1)
+        res["models"][name] = images.scores(f.remaining[te], pred) | {
+            "train_seconds": seconds, "predict_ms_per_frame": 1e3 * per_frame, "parameters": cnn.parameter_count(model)}
+        say(f"  {name}: " + ", ".join(f"{k} {v:.4g}" for k, v in res["models"][name].items()))
+    base, law = _beverloo_per_frame(f, sorted(f.discharge), _first_frames(store, size))
+    res["baseline"] = images.scores(f.remaining[te], base[te]) | {"law": law}
+    _save(out / "compare.json", res)
+    return res
+
+
+def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12, batch: int = 32, lr: float = 1e-4,
+                   seed: int = 0, say=print) -> dict:
+    out = Path(out)
+    f = images.load_frames(store, size=size, every=every)
+    cases = sorted(f.discharge)
+    test_cases = [c for c in cases if c.endswith("-5")]       # one case of every packing
+    val_cases = [c for c in cases if c.endswith("-4")]
+    first = _first_frames(store, size)
+    res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
+                        "frames": int(len(f.x)), "test_cases": test_cases, "validation_cases": val_cases},
+           "machine": _machine(), "splits": {}}
+    for split, (tr, va, te) in (("random_frames", images.random_split(len(f.x), seed)),
+                                ("leave_cases_out", images.case_split(f.case, test_cases, val_cases))):
+        say(f"- AlexNet-FC, {split}: train {len(tr)}, validation {len(va)}, test {len(te)} frames")
+        if not (len(tr) and len(va) and len(te)):
+            say("  an empty part (leave-cases-out holds out the -5 cases and validates on the -4 cases): skipped")
+            continue
+        model, scaling, seconds = _train(f"alexnet_fc_{split}", cnn.AlexNetFC, f, tr, va, epochs, batch, lr, seed, out, say)
+        pred = images.predict(model, f.x[te], scaling)
+        train_cases = sorted(set(f.case[tr]))
+        base, law = _beverloo_per_frame(f, train_cases, first)
+        row = {"all": images.scores(f.remaining[te], pred), "baseline_all": images.scores(f.remaining[te], base[te]),
+               "train_seconds": seconds, "law": law, "per_packing": {}}
+        for pk in PACKINGS:
+            m = np.array([_packing(c) == pk for c in f.case[te]])
+            if m.sum() > 1:
+                row["per_packing"][pk] = {"net": images.scores(f.remaining[te][m], pred[m]),
+                                          "baseline": images.scores(f.remaining[te][m], base[te][m])}
+        res["splits"][split] = row
+        say(f"  R^2 {row['all']['r2']:.3f}, relative error {row['all']['relative_error']:.3f} "
+            f"(baseline {row['baseline_all']['r2']:.3f}, {row['baseline_all']['relative_error']:.3f})")
+    _save(out / "point_to_point.json", res)
+    return res
+
+
+def process(store, out, size: int = 64, window: int = 8, epochs: int = 40, lr: float = 1e-3, seed: int = 0,
+            fraction: float = 0.2, say=print) -> dict:
+    """Per case: the CNN-LSTM trained on windows of the first `fraction` of its frames (the
+    last of them for validation), then each later frame's NRRP read from the window that ends
+    at it."""
+    from pydem.frames import FrameStore
+    out = Path(out)
+    res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction},
+           "machine": _machine(), "cases": {}}
+    for case in FrameStore(store).cases():
+        f = images.load_frames(store, cases=[case], size=size)
+        k = max(window + 2, int(round(fraction * len(f.x))))
+        if len(f.x) < k + window:
+            say(f"  {case}: {len(f.x)} frames, too few for windows of {window}; skipped")
+            continue
+        xw, yw = images.windows(f.x[:k], f.nrrp[:k].astype(np.float32), window)
+        n_val = max(1, len(xw) // 5)
+        torch.manual_seed(seed)
+        model = cnn.CNNLSTM()
+        t0 = time.perf_counter()
+        scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8, lr=lr,
+                             seed=seed, checkpoint=out / f"lstm_{case}.pt")
+        seconds = time.perf_counter() - t0
+        xr, _ = images.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
+        pred = np.clip(images.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
+        truth = f.nrrp[k:]
+        base = images.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
+        res["cases"][case] = {"frames": int(len(f.x)), "trained_on": int(k), "train_seconds": seconds,
+                              "net": images.scores(truth, pred), "baseline": images.scores(truth, base),
+                              "time": f.time[k:].tolist(), "nrrp": truth.tolist(), "predicted": pred.tolist(),
+                              "baseline_nrrp": base.tolist()}
+        say(f"  {case}: relative error {res['cases'][case]['net']['relative_error']:.3f} "
+            f"(constant rate {res['cases'][case]['baseline']['relative_error']:.3f}), {seconds:.0f} s")
+    res["per_packing"] = {pk: {"net": float(np.mean([r["net"]["relative_error"] for c, r in res["cases"].items() if _packing(c) == pk])),
+                               "baseline": float(np.mean([r["baseline"]["relative_error"] for c, r in res["cases"].items() if _packing(c) == pk]))}
+                          for pk in PACKINGS if any(_packing(c) == pk for c in res["cases"])}
+    _save(out / "process.json", res)
+    return res
+
+
+def _save(path: Path, res: dict):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    res["date"] = time.strftime("%Y-%m-%d")
+    path.write_text(json.dumps(res, indent=1, default=float))
