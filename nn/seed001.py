@@ -7,6 +7,7 @@ the 11 Table 1 parameters against the cases' discharge times (nn.gra), per packi
     .venv/bin/python -m nn.seed001 gra --store data/seed001/frames.h5
     .venv/bin/python -m nn.seed001 subset --store data/seed001/frames_full.h5 --out data/seed001/frames_subset.h5 --every 25
     .venv/bin/python -m nn.seed001 compare|point-to-point|process --store STORE --out DIR [--size 64 --epochs N]
+    .venv/bin/python -m nn.seed001 report --store STORE --results DIR --out DIR
 
 The last three are nn.seed001_experiments (the networks beside their physics baselines; results
 as JSON in DIR). The frame campaign is resumable: a case is written whole when its run ends, and a rerun does
@@ -112,7 +113,15 @@ def main(argv=None) -> int:
         e.add_argument("--every", type=int, help="use every N-th stored frame (compare, point-to-point)")
         e.add_argument("--seed", type=int, default=0)
         e.add_argument("--threads", type=int, default=2, help="torch threads")
+    rp = sub.add_parser("report", help="HTML + Markdown report of the GRA and the experiments' results")
+    rp.add_argument("--store", required=True)
+    rp.add_argument("--results", required=True, help="the experiments' --out directory")
+    rp.add_argument("--out", required=True)
     args = ap.parse_args(argv)
+    if args.cmd == "report":
+        from .seed001_report import write
+        print(f"written {write(args.store, args.results, args.out)}")
+        return 0
     if args.cmd == "frames":
         run_frames(args.store, args.cases, args.frame_interval, args.threads)
         return 0

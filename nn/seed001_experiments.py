@@ -108,7 +108,9 @@ def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12,
         train_cases = sorted(set(f.case[tr]))
         base, law = _beverloo_per_frame(f, train_cases, first)
         row = {"all": images.scores(f.remaining[te], pred), "baseline_all": images.scores(f.remaining[te], base[te]),
-               "train_seconds": seconds, "law": law, "per_packing": {}}
+               "train_seconds": seconds, "law": law, "per_packing": {},
+               "test": {"case": f.case[te].tolist(), "remaining": f.remaining[te].tolist(), "predicted": pred.tolist(),
+                        "baseline": base[te].tolist()}}
         for pk in PACKINGS:
             m = np.array([_packing(c) == pk for c in f.case[te]])
             if m.sum() > 1:
