@@ -205,6 +205,10 @@ dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)
 #endif
     ;
 void dem_clear_error(dem_domain *d);
+/* A read-back buffer with room for `capacity` items: DEM_OK when capacity >= count, else
+ * DEM_ERR_INVALID_ARGUMENT with "<fn>: room for <capacity> <what>, <count> to write" (the error
+ * message is the one field of a const domain that a getter writes). */
+dem_status dem_check_room(const dem_domain *d, int64_t capacity, int64_t count, const char *what, const char *fn);
 
 /* Internal invariants, checked in builds with -DDEM_CHECKS (the sanitizer build of `make test`);
  * a broken one calls the hook set by dem_set_assert_hook, else prints and aborts. Free of cost
@@ -245,7 +249,7 @@ static inline double dem_pair_separation(const dem_domain *d, int64_t i, int64_t
 dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask);
 int dem_neighbor_stencil_ok(const dem_domain *d, char *why, size_t why_size);
 
-/* forces.c: plane-wall contacts of particle i added to f/t (*bad: i if an overlap runs
+/* plane_contact.c: plane-wall contacts of particle i added to f/t (*bad: i if an overlap runs
  * away, min), and the messages for a runaway overlap at pair entry k / at particle i. */
 void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, double *t, int64_t *bad);
 dem_status dem_report_runaway_pair(dem_domain *d, int64_t k);
@@ -269,11 +273,21 @@ dem_status dem_mesh_candidates(dem_domain *d);
 void dem_tri_entry_clear(tri_list *tl, int64_t k);
 void dem_mesh_free_all(dem_domain *d);
 
-/* mesh.c: finishing a mesh from x_ref/tri (edges, world, normals; 0: out of memory), adding
- * a finished mesh without the overlap check, freeing one */
+/* balance.c: the sweep's row split d->split for nth threads (prepared before a sweep, moved
+ * toward the measured row times d->split_busy after it) */
+void dem_split_prepare(dem_domain *d, int nth);
+void dem_split_rebalance(dem_domain *d, int nth);
+
+/* mesh_build.c: welding triangle corners (9 doubles each) into m; finishing a mesh from
+ * x_ref/tri (edges, world, normals; 0: out of memory); adding a finished mesh without the
+ * overlap check; freeing one */
+dem_status dem_mesh_build(dem_domain *d, const double *corner, int64_t n, double tol_user, mesh_wall *m,
+                          const char *what);
 int dem_mesh_finish(mesh_wall *m);
 dem_status dem_mesh_append(dem_domain *d, mesh_wall *m, const char *what, int *out);
 void dem_mesh_free(mesh_wall *m);
+/* mesh_cut.c: the first of n particles (x, r) that mesh m cuts, or -1 */
+int64_t dem_mesh_first_cut(const dem_domain *d, const mesh_wall *m, int64_t n, const double *x, const double *r);
 
 /* particles.c: room for n particles and ids below next_id (0: out of memory) */
 int dem_particles_reserve(dem_domain *d, int64_t n, int64_t next_id);

@@ -3,6 +3,7 @@
  * previous list. Everything is deterministic whatever the thread count: counting sort
  * by cell, rows filled in a fixed stencil order, transposed list filled serially. */
 #include "internal.h"
+#include "cell_grid.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -110,10 +111,7 @@ static dem_status choose_cells(dem_domain *d, int64_t n_live)
 
 static inline int cell_coord(const dem_domain *d, double x, int a)
 {
-    double c = floor((x - d->def.lo[a]) / d->cell_size[a]); /* clamp before the cast */
-    if (!(c >= 0.0)) return 0;
-    if (c >= d->ncell[a]) return d->ncell[a] - 1;
-    return (int)c;
+    return cell_clamp(floor((x - d->def.lo[a]) / d->cell_size[a]), d->ncell[a]);
 }
 
 /* Permute a particle array (elements of elem_bytes) into the new order. */
@@ -203,7 +201,7 @@ static int64_t scan_row(const dem_domain *d, int64_t i, scan_buffer *b)
         if (skip) continue;
         double shift[3];
         for (int a = 0; a < 3; a++) shift[a] = sh[a] * (d->def.hi[a] - d->def.lo[a]);
-        int64_t ncell = ((int64_t)nc[2] * d->ncell[1] + nc[1]) * d->ncell[0] + nc[0];
+        int64_t ncell = cell_index(d->ncell, nc[0], nc[1], nc[2]);
         uint8_t image = (uint8_t)((sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1));
         for (int64_t j = d->cell_start[ncell]; j < d->cell_start[ncell + 1]; j++) {
             double dx = x[3 * i] - (x[3 * j] + shift[0]);
@@ -306,9 +304,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
             d->cell_of[i] = -1;
             continue;
         }
-        int64_t c = ((int64_t)cell_coord(d, d->x[3 * i + 2], 2) * d->ncell[1] + cell_coord(d, d->x[3 * i + 1], 1)) *
-                        d->ncell[0] +
-                    cell_coord(d, d->x[3 * i], 0);
+        int64_t c = cell_index(d->ncell, cell_coord(d, d->x[3 * i], 0), cell_coord(d, d->x[3 * i + 1], 1),
+                               cell_coord(d, d->x[3 * i + 2], 2));
         d->cell_of[i] = (int32_t)c;
         d->cell_start[c + 1]++;
     }
@@ -334,9 +331,8 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     permute(d->id, d->perm, n, sizeof(dem_particle_id), scr);
     d->n = n;
     for (int64_t i = 0; i < n; i++) {
-        int64_t c = ((int64_t)cell_coord(d, d->x[3 * i + 2], 2) * d->ncell[1] + cell_coord(d, d->x[3 * i + 1], 1)) *
-                        d->ncell[0] +
-                    cell_coord(d, d->x[3 * i], 0);
+        int64_t c = cell_index(d->ncell, cell_coord(d, d->x[3 * i], 0), cell_coord(d, d->x[3 * i + 1], 1),
+                               cell_coord(d, d->x[3 * i + 2], 2));
         d->cell_of[i] = (int32_t)c;
     }
     for (dem_particle_id k = 0; k < d->next_id; k++) d->index_of_id[k] = -1;

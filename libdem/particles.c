@@ -1,6 +1,7 @@
 /* Particles: validated bulk insertion (all-or-nothing, overlap-checked), removal,
  * read-back in ascending id order. */
 #include "internal.h"
+#include "cell_grid.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,30 +54,28 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
     double rmax = d->r_max;
     for (int64_t k = 0; k < n_new; k++)
         if (rad[k] > rmax) rmax = rad[k];
-    int nc[3];
-    double cs[3];
-    int64_t ncells = 1;
+    cell_grid g;
     for (int a = 0; a < 3; a++) {
         double len = d->def.hi[a] - d->def.lo[a];
-        nc[a] = (int)floor(len / (2.0 * rmax));
-        if (nc[a] < 1) nc[a] = 1;
-        if (nc[a] > 1024) nc[a] = 1024;
+        g.n[a] = (int)floor(len / (2.0 * rmax));
+        if (g.n[a] < 1) g.n[a] = 1;
+        if (g.n[a] > 1024) g.n[a] = 1024;
     }
-    while ((ncells = (int64_t)nc[0] * nc[1] * nc[2]) > 2 * total + 1024) {
-        int a = nc[0] >= nc[1] && nc[0] >= nc[2] ? 0 : (nc[1] >= nc[2] ? 1 : 2);
-        nc[a] = (nc[a] + 1) / 2;
+    while ((int64_t)g.n[0] * g.n[1] * g.n[2] > 2 * total + 1024) {
+        int a = g.n[0] >= g.n[1] && g.n[0] >= g.n[2] ? 0 : (g.n[1] >= g.n[2] ? 1 : 2);
+        g.n[a] = (g.n[a] + 1) / 2;
     }
-    for (int a = 0; a < 3; a++) cs[a] = (d->def.hi[a] - d->def.lo[a]) / nc[a];
-    int64_t *head = malloc((size_t)ncells * sizeof *head), *next = malloc((size_t)total * sizeof *next);
+    for (int a = 0; a < 3; a++) {
+        g.lo[a] = d->def.lo[a];
+        g.size[a] = (d->def.hi[a] - d->def.lo[a]) / g.n[a];
+    }
+    const int *nc = g.n;
     int32_t *cellc = malloc((size_t)total * 3 * sizeof *cellc);
-    if (!head || !next || !cellc) {
-        free(head);
-        free(next);
+    if (!cellc || !cell_grid_alloc(&g, total)) {
         free(cellc);
         *no_memory = 1;
         return -1;
     }
-    for (int64_t c = 0; c < ncells; c++) head[c] = -1;
 #define P(q) ((q) < n_old ? d->x + 3 * (q) : pos + 3 * ((q) - n_old))
 #define R(q) ((q) < n_old ? d->radius[(q)] : rad[(q) - n_old])
     for (int64_t q = 0; q < total; q++) {
@@ -87,12 +86,9 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
                 double len = d->def.hi[a] - d->def.lo[a];
                 u -= floor(u / len) * len;
             }
-            int ca = (int)floor(u / cs[a]);
-            cellc[3 * q + a] = ca < 0 ? 0 : (ca >= nc[a] ? nc[a] - 1 : ca);
+            cellc[3 * q + a] = cell_clamp(floor(u / g.size[a]), nc[a]);
         }
-        int64_t c = ((int64_t)cellc[3 * q + 2] * nc[1] + cellc[3 * q + 1]) * nc[0] + cellc[3 * q];
-        next[q] = head[c];
-        head[c] = q;
+        cell_grid_push(&g, q, cell_index(nc, cellc[3 * q], cellc[3 * q + 1], cellc[3 * q + 2]));
     }
     int64_t found = -1;
     for (int64_t q = n_old; q < total && found < 0; q++) {
@@ -111,8 +107,7 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
                         if (d->def.periodic[a] && nc[a] < 3 && off[a] != 0 && (nc[a] == 1 || off[a] < 0)) skip = 1;
                     }
                     if (skip) continue;
-                    int64_t c = ((int64_t)c3[2] * nc[1] + c3[1]) * nc[0] + c3[0];
-                    for (int64_t o = head[c]; o >= 0; o = next[o]) {
+                    for (int64_t o = g.head[cell_index(nc, c3[0], c3[1], c3[2])]; o >= 0; o = g.next[o]) {
                         if (o == q || (o >= n_old && o > q)) continue; /* each new pair once */
                         const double *po = P(o);
                         double r2 = 0.0;
@@ -136,8 +131,7 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
     }
 #undef P
 #undef R
-    free(head);
-    free(next);
+    cell_grid_free(&g);
     free(cellc);
     return found;
 }
@@ -263,22 +257,12 @@ dem_status dem_particles_remove(dem_domain *d, int64_t n, const dem_particle_id 
 
 int64_t dem_particle_count(const dem_domain *d) { return d ? d->n : 0; }
 
-/* A read-back buffer with room for `capacity` particles: enough for all of them? (The error
- * message is the one field of a const domain that a getter writes.) */
-static dem_status room_for(const dem_domain *d, int64_t capacity, const char *fn)
-{
-    if (capacity < d->n)
-        return dem_fail((dem_domain *)d, DEM_ERR_INVALID_ARGUMENT, "%s: room for %lld particles, the domain has %lld", fn,
-                        (long long)capacity, (long long)d->n);
-    return DEM_OK;
-}
-
 /* Copy `width` doubles per particle from src into out, ascending id order. */
 static dem_status read_back(const dem_domain *d, const double *src, int width, double *out, int64_t capacity,
                             const char *fn)
 {
     if (!d || !out) return DEM_ERR_NULL;
-    dem_status s = room_for(d, capacity, fn);
+    dem_status s = dem_check_room(d, capacity, d->n, "particles", fn);
     if (s != DEM_OK) return s;
     int64_t q = 0;
     for (dem_particle_id id = 0; id < d->next_id; id++) {
@@ -293,7 +277,7 @@ static dem_status read_back(const dem_domain *d, const double *src, int width, d
 dem_status dem_particles_get_ids(const dem_domain *d, dem_particle_id *ids, int64_t capacity)
 {
     if (!d || !ids) return DEM_ERR_NULL;
-    dem_status s = room_for(d, capacity, "dem_particles_get_ids");
+    dem_status s = dem_check_room(d, capacity, d->n, "particles", "dem_particles_get_ids");
     if (s != DEM_OK) return s;
     int64_t q = 0;
     for (dem_particle_id id = 0; id < d->next_id; id++)

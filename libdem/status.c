@@ -49,6 +49,13 @@ dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)
 
 void dem_clear_error(dem_domain *d) { d->errmsg[0] = '\0'; }
 
+dem_status dem_check_room(const dem_domain *d, int64_t capacity, int64_t count, const char *what, const char *fn)
+{
+    if (capacity >= count) return DEM_OK;
+    return dem_fail((dem_domain *)d, DEM_ERR_INVALID_ARGUMENT, "%s: room for %lld %s, %lld to write", fn,
+                    (long long)capacity, what, (long long)count);
+}
+
 const char *dem_domain_last_error(const dem_domain *d) { return d ? d->errmsg : "domain is NULL"; }
 
 void *dem_realloc_array(void *p, size_t count, size_t elem)

@@ -1,5 +1,5 @@
-/* Plane-wall contacts and the runaway-overlap reports. (Pair contacts are evaluated in the
- * force sweep, sweep.c, with the same contact_law().) */
+/* Plane-wall contacts (the contact law of contact_law.h against an analytic plane) and the
+ * runaway-overlap reports of every contact kind. (Pair contacts: the force sweep, sweep.c.) */
 #include "contact_law.h"
 #include <math.h>
 
