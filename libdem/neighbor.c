@@ -261,12 +261,13 @@ static void check_lists(const dem_domain *d)
 #endif
 }
 
-dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
+/* ---- the phases of a build ----------------------------------------------------------- */
+
+/* Live particles (not in remove_mask): their count; the largest radius and the one material
+ * of them all (-2: several) into the domain. */
+static int64_t count_live(dem_domain *d, const unsigned char *remove_mask)
 {
     const int64_t n_old = d->n;
-    const int nt = d->def.num_threads;
-
-    /* live particles, largest radius */
     int64_t n = 0;
     double rmax = 0.0;
     int32_t material = -1; /* the one material of every particle, or -2 */
@@ -278,10 +279,13 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     }
     d->r_max = rmax;
     d->single_material = material;
-    dem_status s = choose_cells(d, n);
-    if (s != DEM_OK) return s;
+    return n;
+}
 
-    /* wrap periodic axes (positions drift out by < skin between builds) */
+/* Periodic axes: positions back into the box (they drift out by < skin between builds). */
+static void wrap_periodic(dem_domain *d)
+{
+    const int64_t n_old = d->n;
     for (int64_t i = 0; i < n_old; i++)
         for (int a = 0; a < 3; a++)
             if (d->def.periodic[a]) {
@@ -293,7 +297,12 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
                 }
             }
 
-    /* counting sort by cell (stable, so deterministic) */
+}
+
+/* Counting sort of the live particles by cell (stable, so deterministic): d->perm[new] = old. */
+static dem_status sort_by_cell(dem_domain *d, const unsigned char *remove_mask)
+{
+    const int64_t n_old = d->n;
     int64_t tmp_cap = d->cap_cells;
     if (!grow((void **)&d->cell_start, &tmp_cap, d->n_cells + 1, sizeof *d->cell_start))
         return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for %lld cells", (long long)d->n_cells);
@@ -318,7 +327,13 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n_old; i++) /* perm[new] = old */
         if (d->cell_of[i] >= 0) d->perm[cursor[d->cell_of[i]]++] = (int32_t)i;
 
-    /* reorder particle arrays */
+    return DEM_OK;
+}
+
+/* The particle arrays into the sorted order (n live particles); cells, id index and the
+ * positions at this build follow. */
+static void reorder_particles(dem_domain *d, int64_t n)
+{
     void *scr = d->f; /* the forces are recomputed after every build: their array is free */
     d->forces_valid = 0;
     permute(d->x, d->perm, n, 3 * sizeof(double), scr);
@@ -339,19 +354,16 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     for (int64_t i = 0; i < n; i++) d->index_of_id[d->id[i]] = (int32_t)i;
     memcpy(d->x_build, d->x, (size_t)n * 3 * sizeof(double));
 
-    /* swap the lists: the old one keeps the histories, indexed by old particle index */
-    pair_list tp = d->pairs_old;
-    d->pairs_old = d->pairs_cur;
-    d->pairs_cur = tp;
-    wall_list tw = d->walls_old;
-    d->walls_old = d->walls_cur;
-    d->walls_cur = tw;
+}
+
+/* The pair list: each thread scans its rows into its buffer; prefix; copy + histories from the
+ * old list (the buffers stay with the domain: a build at a size seen before allocates nothing). */
+static dem_status build_pair_list(dem_domain *d, int64_t n)
+{
+    const int nt = d->def.num_threads;
     pair_list *pl = &d->pairs_cur;
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;
-
-    /* pair list: each thread scans its rows into its buffer; prefix; copy + histories (the
-     * buffers stay with the domain: a build at a size seen before allocates nothing) */
     if (d->n_scan < nt) {
         scan_buffer *grown = dem_realloc_array(d->scan, (size_t)nt, sizeof *grown);
         if (!grown) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
@@ -407,7 +419,16 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     }
     if (!ok) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the pair list");
 
-    /* per-entry force scratch and the transposed list (entries where a particle is j) */
+    return DEM_OK;
+}
+
+/* Per-entry force scratch and the transposed list (the entries where a particle is j), and
+ * which rows name each particle: the sweep's finishing order. */
+static dem_status build_transposed(dem_domain *d, int64_t n)
+{
+    const pair_list *pl = &d->pairs_cur;
+    const int64_t count = pl->count, *start = pl->start;
+    int64_t *cursor = d->cursor;
     if (refit(count, d->trans_capacity)) {
         int64_t c = margin(count);
         void **slots[] = {(void **)&d->slot};
@@ -440,7 +461,13 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
             if (i > d->trans_hi[j]) d->trans_hi[j] = (int32_t)i;
         }
 
-    /* wall candidates, grouped by particle */
+    return DEM_OK;
+}
+
+/* Plane-wall candidates, grouped by particle, with their histories from the old list. */
+static dem_status build_wall_list(dem_domain *d, int64_t n)
+{
+    const int64_t old_rows = d->pairs_old.start ? d->pairs_old.n_rows : 0;
     wall_list *wl = &d->walls_cur;
     const wall_list *wold = &d->walls_old;
     if (!dem_reserve_rows(&wl->start, &wl->start_cap, n)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
@@ -472,6 +499,29 @@ dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
     }
     wl->count = wc;
 
+    return DEM_OK;
+}
+
+dem_status dem_neighbor_rebuild(dem_domain *d, const unsigned char *remove_mask)
+{
+    const int64_t n = count_live(d, remove_mask);
+    dem_status s = choose_cells(d, n);
+    if (s != DEM_OK) return s;
+    wrap_periodic(d);
+    s = sort_by_cell(d, remove_mask);
+    if (s != DEM_OK) return s;
+    reorder_particles(d, n);
+    /* swap the lists: the old one keeps the histories, indexed by old particle index */
+    pair_list tp = d->pairs_old;
+    d->pairs_old = d->pairs_cur;
+    d->pairs_cur = tp;
+    wall_list tw = d->walls_old;
+    d->walls_old = d->walls_cur;
+    d->walls_cur = tw;
+
+    if ((s = build_pair_list(d, n)) != DEM_OK || (s = build_transposed(d, n)) != DEM_OK ||
+        (s = build_wall_list(d, n)) != DEM_OK)
+        return s;
     s = dem_mesh_candidates(d);
     if (s != DEM_OK) return s;
     check_lists(d);
