@@ -64,14 +64,19 @@ def run_frames(store_path: str, cases: list[str], frame_interval: float, threads
             continue
         cfg = load(cfg_cls, "default", None, [f"case={case}", f"frame_interval={frame_interval}", f"num_threads={threads}"])
         t0 = time.perf_counter()
-        res = cls(cfg).run(seed=0, images=True)
+        try:
+            res = cls(cfg).run(seed=0, images=True)
+        except Exception as exc:  # one case that fails (a runaway overlap, a jam) does not stop the others
+            say(f"  {case}: the run failed ({exc}); not stored")
+            continue
         t_dis = res.metrics["discharge_time"].value
         if not np.isfinite(t_dis):
             say(f"  {case}: did not empty ({res.metrics['discharge_time'].note}); not stored")
             continue
         store.write_case(case, res.images, res.series["frame_time"], t_dis, res.series["frame_nrrp"],
                          {"packing": case.split("-")[0], **{f"param_{k}": v for k, v in parameter_row(case).items()},
-                          "particles": res.info["particles"], "frame_interval": frame_interval})
+                          "particles": res.info["particles"], "frame_interval": frame_interval,
+                          "dem_seconds": time.perf_counter() - t0})
         say(f"  {case}: {len(res.images)} frames, discharge time {t_dis:.3f} s, {time.perf_counter() - t0:.0f} s")
 
 
