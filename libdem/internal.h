@@ -31,6 +31,9 @@ typedef struct pair_props {
 typedef struct plane_wall {
     dem_plane_wall_def def;
     double normal[3];
+    /* time average of the wall force (wall_mean_force.c): the integral since the last reset */
+    int averaging;
+    double impulse[3], averaged_time;
 } plane_wall;
 
 /* A triangle-mesh wall. Vertices are stored as loaded (reference) and as moved (world):
@@ -64,7 +67,7 @@ typedef struct mesh_wall {
     dem_servo_def servo;
     double servo_force;      /* filtered measured force along -direction, N */
     int servo_primed;        /* the filter has seen a first value */
-    /* time average of the wall force (mesh_mean_force.c): integrals since the last reset */
+    /* time average of the wall force (wall_mean_force.c): integrals since the last reset */
     int averaging;           /* accumulate every step */
     double impulse[3];       /* sum of F dt, N s */
     double moment_impulse[3];/* sum of (x - 0) x F dt about the origin, N m s */
@@ -301,8 +304,9 @@ void dem_mesh_update_world(mesh_wall *m);
 int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x, const double *r, int *which_mesh);
 /* force the particles exert on mesh m during the last step (N) */
 void dem_mesh_total_force(const dem_domain *d, int m, double force[3]);
-/* mesh_mean_force.c: add the force of the step just computed, times dt, to every averaging mesh */
-void dem_meshes_accumulate_mean_force(dem_domain *d, double dt);
+/* wall_mean_force.c: add the force of the step just computed, times dt, to every averaging
+ * mesh and plane wall */
+void dem_walls_accumulate_mean_force(dem_domain *d, double dt);
 
 /* neighbor.c: frees the build's scratch */
 void dem_neighbor_free_scratch(dem_domain *d);

@@ -1,6 +1,6 @@
 /* What the particles do to a mesh wall: its total force and torque, the force on each
  * triangle, the stress over an area, from the last step's triangle contacts. The servo reads
- * the total force (mesh_motion.c); the time average: mesh_mean_force.c. */
+ * the total force (mesh_motion.c); the time average: wall_mean_force.c. */
 #include "internal.h"
 #include <math.h>
 #include <stdlib.h>

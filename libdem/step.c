@@ -129,7 +129,7 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         d->tris_cur.count = 0;
         for (int64_t s = 0; s < n_steps; s++) {
             dem_meshes_update_servos(d);
-            dem_meshes_accumulate_mean_force(d, dt);
+            dem_walls_accumulate_mean_force(d, dt);
             dem_meshes_move(d, dt);
             d->step++;
             d->time += dt;
@@ -194,7 +194,7 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
                                            : dem_report_runaway_wall(d, m.bad_wall);
         }
         dem_meshes_update_servos(d);
-        dem_meshes_accumulate_mean_force(d, dt);
+        dem_walls_accumulate_mean_force(d, dt);
         if (s + 1 < n_steps) dem_meshes_move(d, dt);
         d->step++;
         d->time += dt;

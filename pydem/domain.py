@@ -185,6 +185,14 @@ class Domain:
         return {"restitution": p.restitution, "friction": p.friction, "rolling_friction": p.rolling_friction,
                 "rolling_model": model, "rolling_damping": p.rolling_damping}
 
+    def pair_damping_factor(self, a: int, b: int) -> float:
+        """The damping factor libdem uses for pair (a, b) so that the delivered restitution is the
+        requested one with the normal force clipped at zero: gamma_n = factor sqrt(S_n m*)
+        (docs/libdem.md, "Restitution")."""
+        out = ffi.new("double *")
+        self._check(lib.dem_pair_damping_factor(self._d, a, b, out))
+        return float(out[0])
+
     def set_effect(self, a: int, b: int, name: str, *values: float, **named: float):
         """Switches effect `name` on for pair (a, b): parameters by position or by name;
         all-neutral values switch it off."""

@@ -34,6 +34,17 @@ class PlaneWall:
         self.domain._check(lib.dem_plane_wall_force(self.domain._d, self.index, f))
         return np.array(list(f))
 
+    def reset_mean_force(self) -> None:
+        """Starts (or restarts) the time average of the wall force read by mean_force."""
+        self.domain._check(lib.dem_plane_wall_reset_mean_force(self.domain._d, self.index))
+
+    def mean_force(self) -> tuple[np.ndarray, float]:
+        """(force, seconds): the wall force averaged over every step since reset_mean_force, and
+        the time averaged (0 with zero force when no step was taken)."""
+        f, sec = ffi.new("double[3]"), ffi.new("double *")
+        self.domain._check(lib.dem_plane_wall_mean_force(self.domain._d, self.index, f, sec))
+        return np.array(list(f)), float(sec[0])
+
 
 class MeshWall:
     """A triangle-mesh wall: moving, load-controlled, with forces per wall and per triangle."""

@@ -103,6 +103,11 @@ DEM_API dem_status dem_plane_wall_add(dem_domain *domain, const dem_plane_wall_d
 DEM_API dem_status dem_plane_wall_set_velocity(dem_domain *domain, int wall, const double velocity[3]);
 /* Total force exerted by the particles on the wall during the last step (N). */
 DEM_API dem_status dem_plane_wall_force(const dem_domain *domain, int wall, double force[3]);
+/* Time-averaged force (N) over the steps since the last reset (as for mesh walls, mesh.h):
+ * reset starts or restarts the average; *seconds (may be NULL) gets the time averaged over, and
+ * the force is zero before the first step. Not part of snapshots. */
+DEM_API dem_status dem_plane_wall_reset_mean_force(dem_domain *domain, int wall);
+DEM_API dem_status dem_plane_wall_mean_force(const dem_domain *domain, int wall, double force[3], double *seconds);
 
 #ifdef __cplusplus
 }

@@ -138,6 +138,82 @@ static void test_mean_wall_force(void **state)
     dem_domain_destroy(d);
 }
 
+/* The plane-wall time average: the mean of the per-step forces (to rounding: the same sums)
+ * while the column falls onto a plane floor, then the column's weight, on the floor and by
+ * friction on the four plane sides, once it rests (0.1 %, as the mesh box: the residual is the
+ * bed's remaining momentum change). */
+static void test_plane_wall_mean_force(void **state)
+{
+    (void)state;
+    dem_domain_def def = dem_default_domain_def();
+    for (int a = 0; a < 3; a++) {
+        def.lo[a] = -0.001;
+        def.hi[a] = (a == 2 ? H : L) + 0.001;
+    }
+    def.dt = 5e-6;
+    dem_domain *d;
+    char msg[256];
+    assert_ok(dem_domain_create(&def, &d, msg, sizeof msg));
+    dem_material_def md = dem_default_material_def();
+    int mat, floor_wall, side[4];
+    assert_ok(dem_material_create(d, &md, &mat));
+    dem_pair_def p = dem_default_pair_def();
+    p.restitution = 0.2;
+    p.friction = 0.3;
+    assert_ok(dem_pair_set(d, mat, mat, &p));
+    dem_plane_wall_def w = dem_default_plane_wall_def(); /* floor z >= 0 */
+    w.material = mat;
+    assert_ok(dem_plane_wall_add(d, &w, &floor_wall));
+    for (int k = 0; k < 4; k++) { /* the four sides of an L x L column */
+        w.axis = k / 2;
+        w.side = k % 2 ? -1 : 1;
+        w.position = k % 2 ? L : 0.0;
+        assert_ok(dem_plane_wall_add(d, &w, &side[k]));
+    }
+    double pos[3 * 100], rad[100];
+    int mats[100];
+    int64_t n = 0;
+    uint64_t rng = 11;
+    for (int z = 0; z < 4; z++)
+        for (int y = 0; y < 5; y++)
+            for (int x = 0; x < 5; x++, n++) {
+                pos[3 * n] = 0.0007 + 1.15e-3 * x + 5e-5 * (test_urand(&rng) - 0.5);
+                pos[3 * n + 1] = 0.0007 + 1.15e-3 * y + 5e-5 * (test_urand(&rng) - 0.5);
+                pos[3 * n + 2] = 0.0008 + 1.15e-3 * z;
+                rad[n] = R * (0.9 + 0.1 * test_urand(&rng));
+                mats[n] = mat;
+            }
+    assert_ok(dem_particles_add(d, n, pos, rad, mats, NULL, NULL, NULL));
+    double f[3], sec = -1.0, fs[3] = {0, 0, 0};
+    assert_ok(dem_plane_wall_reset_mean_force(d, floor_wall));
+    assert_ok(dem_plane_wall_mean_force(d, floor_wall, f, &sec));
+    assert_true(sec == 0.0 && f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0); /* no step yet */
+    assert_int_equal(dem_plane_wall_reset_mean_force(d, 9), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_plane_wall_mean_force(d, -1, f, &sec), DEM_ERR_UNKNOWN_WALL);
+    const int steps = 3000; /* falling and landing: a rattling force */
+    for (int s = 0; s < steps; s++) {
+        assert_ok(dem_domain_step(d, 1));
+        assert_ok(dem_plane_wall_force(d, floor_wall, f));
+        for (int a = 0; a < 3; a++) fs[a] += f[a] / steps;
+    }
+    assert_ok(dem_plane_wall_mean_force(d, floor_wall, f, &sec));
+    assert_close(sec, steps * 5e-6, 1e-12, 0);
+    assert_true(fs[2] < 0.0); /* the particles have landed: they push the floor down */
+    for (int a = 0; a < 3; a++) assert_close(f[a], fs[a], 1e-9, 1e-12 * fabs(fs[2]));
+    assert_ok(dem_domain_step(d, 40000)); /* settled */
+    assert_ok(dem_plane_wall_reset_mean_force(d, floor_wall));
+    for (int k = 0; k < 4; k++) assert_ok(dem_plane_wall_reset_mean_force(d, side[k]));
+    assert_ok(dem_domain_step(d, 2000));
+    assert_ok(dem_plane_wall_mean_force(d, floor_wall, f, NULL));
+    double down = -f[2]; /* the floor and, by friction, the sides carry the weight */
+    for (int k = 0; k < 4; k++) {
+        assert_ok(dem_plane_wall_mean_force(d, side[k], f, NULL));
+        down -= f[2];
+    }
+    assert_close(down, total_weight(d, n), 1e-3, 0);
+    dem_domain_destroy(d);
+}
+
 static void test_servo_lid_and_region_stress(void **state)
 {
     (void)state;
@@ -259,6 +335,7 @@ int main(void)
         cmocka_unit_test(test_single_sphere_closed_form),
         cmocka_unit_test(test_column_weight_on_walls),
         cmocka_unit_test(test_mean_wall_force),
+        cmocka_unit_test(test_plane_wall_mean_force),
         cmocka_unit_test(test_servo_lid_and_region_stress),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

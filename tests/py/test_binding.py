@@ -128,6 +128,32 @@ def test_hertz_impact_through_python():
     assert d.velocities[0, 2] == pytest.approx(v, rel=2e-3)  # elastic: rebounds at v
 
 
+def test_plane_wall_mean_force_is_the_impulse_of_an_impact():
+    """A sphere bounces off a plane (no gravity, e = 0.5): the wall's time-averaged force times
+    the time averaged is the momentum the sphere lost, m (v_in + v_out) (impulse-momentum; to
+    rounding), and the rebound speed is e v. The damping factor that delivers e falls as e
+    rises and vanishes at e = 1."""
+    R, rho, E, nu, v, e = 1e-3, 2500.0, 1e8, 0.25, 0.2, 0.5
+    m = rho * 4 / 3 * np.pi * R**3
+    d = pydem.Domain(hi=(0.01, 0.01, 0.01), gravity=(0, 0, 0), dt=1e-7)
+    mat = d.add_material(youngs_modulus=E, poisson_ratio=nu, density=rho)
+    d.set_pair(mat, mat, restitution=e, friction=0.0)
+    floor = d.add_plane_wall(material=mat)
+    d.add_particles([[0.005, 0.005, R + 1e-7]], R, mat, velocities=[[0, 0, -v]])
+    floor.reset_mean_force()
+    d.step(3000)  # the contact lasts ~1300 steps
+    f, seconds = floor.mean_force()
+    v_out = d.velocities[0, 2]
+    assert seconds == pytest.approx(3000 * 1e-7, rel=1e-12)
+    assert v_out == pytest.approx(e * v, rel=5e-3)
+    assert -f[2] * seconds == pytest.approx(m * (v + v_out), rel=1e-9)
+    factors = []
+    for r in (0.2, 0.5, 0.9, 1.0):
+        d.set_pair(mat, mat, restitution=r)
+        factors.append(d.pair_damping_factor(mat, mat))
+    assert factors[0] > factors[1] > factors[2] > 0.0 and factors[3] == 0.0
+
+
 def test_snapshot_and_render_round_trip(tmp_path):
     d, m = _box(3)
     d.velocities = [[0.01, 0, 0]] * 3

@@ -1,11 +1,29 @@
-/* Time-averaged mesh-wall force: the integral of the force the particles exert on a wall over
- * every step since a reset. A snapshot of a lid's force in a sheared bed rattles by tens of
- * per cent from step to step; rigs that want a stress want this average. */
+/* Time-averaged wall force, for mesh and plane walls: the integral of the force the particles
+ * exert on a wall over every step since a reset. A snapshot of a lid's force in a sheared bed
+ * rattles by tens of per cent from step to step; rigs that want a stress want this average. */
 #include "internal.h"
 #include <string.h>
 
-void dem_meshes_accumulate_mean_force(dem_domain *d, double dt)
+static void planes_accumulate(dem_domain *d, double dt)
 {
+    int any = 0;
+    for (int w = 0; w < d->n_walls; w++) {
+        plane_wall *p = &d->walls[w];
+        if (p->averaging) p->averaged_time += dt;
+        any |= p->averaging;
+    }
+    if (!any || d->n == 0) return;
+    const wall_list *wl = &d->walls_cur;
+    for (int64_t k = 0; k < wl->count; k++) {
+        plane_wall *p = &d->walls[wl->wall[k]];
+        if (p->averaging)
+            for (int a = 0; a < 3; a++) p->impulse[a] -= wl->force[3 * k + a] * dt; /* wl->force acts on the particle */
+    }
+}
+
+void dem_walls_accumulate_mean_force(dem_domain *d, double dt)
+{
+    planes_accumulate(d, dt);
     int any = 0;
     for (int k = 0; k < d->n_meshes; k++) {
         mesh_wall *m = &d->meshes[k];
@@ -60,6 +78,31 @@ dem_status dem_mesh_wall_mean_force(const dem_domain *d, int mesh, const double 
         torque[1] = m0[1] - (p[2] * f[0] - p[0] * f[2]);
         torque[2] = m0[2] - (p[0] * f[1] - p[1] * f[0]);
     }
+    if (seconds) *seconds = t;
+    return DEM_OK;
+}
+
+dem_status dem_plane_wall_reset_mean_force(dem_domain *d, int wall)
+{
+    if (!d) return DEM_ERR_NULL;
+    if (wall < 0 || wall >= d->n_walls)
+        return dem_fail(d, DEM_ERR_UNKNOWN_WALL, "dem_plane_wall_reset_mean_force: unknown plane wall %d (%d exist)", wall,
+                        d->n_walls);
+    plane_wall *p = &d->walls[wall];
+    p->averaging = 1;
+    memset(p->impulse, 0, sizeof p->impulse);
+    p->averaged_time = 0.0;
+    dem_clear_error(d);
+    return DEM_OK;
+}
+
+dem_status dem_plane_wall_mean_force(const dem_domain *d, int wall, double force[3], double *seconds)
+{
+    if (!d || !force) return DEM_ERR_NULL;
+    if (wall < 0 || wall >= d->n_walls) return DEM_ERR_UNKNOWN_WALL;
+    const plane_wall *p = &d->walls[wall];
+    const double t = p->averaged_time, inv = t > 0.0 ? 1.0 / t : 0.0;
+    for (int a = 0; a < 3; a++) force[a] = p->impulse[a] * inv;
     if (seconds) *seconds = t;
     return DEM_OK;
 }
