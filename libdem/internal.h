@@ -276,6 +276,9 @@ dem_status dem_mesh_candidates(dem_domain *d);
 void dem_tri_entry_clear(tri_list *tl, int64_t k);
 void dem_mesh_free_all(dem_domain *d);
 
+/* materials.c: a material's shear modulus (given, or E / (2 (1 + nu))) */
+double dem_material_shear_modulus(const dem_material_def *m);
+
 /* balance.c: the sweep's row split d->split for nth threads (prepared before a sweep, moved
  * toward the measured row times d->split_busy after it) */
 void dem_split_prepare(dem_domain *d, int nth);

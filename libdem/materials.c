@@ -10,6 +10,7 @@ dem_material_def dem_default_material_def(void)
     m.youngs_modulus = 5e6;
     m.poisson_ratio = 0.25;
     m.density = 2500.0;
+    m.shear_modulus = 0.0;
     return m;
 }
 
@@ -29,6 +30,20 @@ const pair_props *dem_pair_props(const dem_domain *d, int a, int b)
     return &d->pairs[(size_t)a * d->n_materials + b];
 }
 
+/* (2 - nu) / G of a material: its share of 1 / G*. The isotropic form keeps the expression in E
+ * it always had (the same rounding: results of isotropic materials are bitwise those before G
+ * could be given). */
+static double shear_compliance(const dem_material_def *m)
+{
+    if (m->shear_modulus > 0.0) return (2 - m->poisson_ratio) / m->shear_modulus;
+    return 2 * (2 - m->poisson_ratio) * (1 + m->poisson_ratio) / m->youngs_modulus;
+}
+
+double dem_material_shear_modulus(const dem_material_def *m)
+{
+    return m->shear_modulus > 0.0 ? m->shear_modulus : m->youngs_modulus / (2.0 * (1.0 + m->poisson_ratio));
+}
+
 /* Recompute E*, G*, damping of pair (a, b) and its mirror from the materials and def. */
 void dem_pair_recompute(dem_domain *d, int a, int b)
 {
@@ -36,8 +51,7 @@ void dem_pair_recompute(dem_domain *d, int a, int b)
     const dem_material_def *ma = &d->materials[a], *mb = &d->materials[b];
     p->e_star = 1.0 / ((1 - ma->poisson_ratio * ma->poisson_ratio) / ma->youngs_modulus +
                        (1 - mb->poisson_ratio * mb->poisson_ratio) / mb->youngs_modulus);
-    p->g_star = 1.0 / (2 * (2 - ma->poisson_ratio) * (1 + ma->poisson_ratio) / ma->youngs_modulus +
-                       2 * (2 - mb->poisson_ratio) * (1 + mb->poisson_ratio) / mb->youngs_modulus);
+    p->g_star = 1.0 / (shear_compliance(ma) + shear_compliance(mb));
     p->damping_factor = dem_damping_factor_for_restitution(p->def.restitution);
     p->st_over_sn_sqrt = sqrt(4.0 * p->g_star / p->e_star);
     d->pairs[(size_t)b * d->n_materials + a] = *p;
@@ -51,6 +65,10 @@ static dem_status check_material(dem_domain *d, const dem_material_def *m)
     if (!dem_is_finite(m->poisson_ratio) || m->poisson_ratio <= -1.0 || m->poisson_ratio >= 0.5)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "material: Poisson ratio must be in (-1, 0.5), got %g",
                         m->poisson_ratio);
+    if (!dem_is_finite(m->shear_modulus) || m->shear_modulus < 0)
+        return dem_fail(d, DEM_ERR_INVALID_ARGUMENT,
+                        "material: shear modulus must be finite and > 0 Pa (or 0: E / (2 (1 + nu))), got %g",
+                        m->shear_modulus);
     if (!dem_is_finite(m->density) || m->density <= 0)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "material: density must be finite and > 0 kg/m^3, got %g",
                         m->density);

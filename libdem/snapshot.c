@@ -108,12 +108,13 @@ static int write_materials(hid_t f, const dem_domain *d)
     double *buf = malloc((np > (size_t)nm ? np : (size_t)nm) * 5 * sizeof(double) + 8);
     int32_t *ibuf = malloc(np * sizeof(int32_t) + 4);
     int ok = buf && ibuf;
-    for (int k = 0; ok && k < 3; k++) {
+    static const char *const field[4] = {"youngs_modulus", "poisson_ratio", "density", "shear_modulus"};
+    for (int k = 0; ok && k < 4; k++) {
         for (int m = 0; m < nm; m++) {
             const dem_material_def *md = &d->materials[m];
-            buf[m] = k == 0 ? md->youngs_modulus : k == 1 ? md->poisson_ratio : md->density;
+            buf[m] = k == 0 ? md->youngs_modulus : k == 1 ? md->poisson_ratio : k == 2 ? md->density : md->shear_modulus;
         }
-        ok = w_dset(g, k == 0 ? "youngs_modulus" : k == 1 ? "poisson_ratio" : "density", H5T_NATIVE_DOUBLE, (hsize_t)nm, 0, buf);
+        ok = w_dset(g, field[k], H5T_NATIVE_DOUBLE, (hsize_t)nm, 0, buf);
     }
     /* pair table: restitution, friction, rolling_friction, rolling_damping per (a, b); model separately */
     for (size_t p = 0; ok && p < np; p++) {

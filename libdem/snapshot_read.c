@@ -131,7 +131,7 @@ static dem_status read_materials(reader *r)
     if (g < 0) return bad(r, "group 'materials' missing");
     dem_status st = DEM_OK;
     int64_t nm = r_rows(g, "density");
-    double *e = NULL, *nu = NULL, *rho = NULL, *pairs = NULL, *epar = NULL;
+    double *e = NULL, *nu = NULL, *rho = NULL, *gmod = NULL, *pairs = NULL, *epar = NULL;
     int32_t *model = NULL, *eidx = NULL;
     if (nm < 0 || nm > 4096) {
         st = bad(r, "materials/density missing");
@@ -141,9 +141,10 @@ static dem_status read_materials(reader *r)
     e = malloc((size_t)nm * sizeof *e + 8);
     nu = malloc((size_t)nm * sizeof *nu + 8);
     rho = malloc((size_t)nm * sizeof *rho + 8);
+    gmod = calloc((size_t)nm + 1, sizeof *gmod);
     pairs = malloc(np * 4 * sizeof *pairs + 8);
     model = malloc(np * sizeof *model + 4);
-    if (!e || !nu || !rho || !pairs || !model) {
+    if (!e || !nu || !rho || !gmod || !pairs || !model) {
         st = bad(r, "out of memory");
         goto out;
     }
@@ -154,8 +155,13 @@ static dem_status read_materials(reader *r)
         st = bad(r, "materials: a dataset is missing or has the wrong shape");
         goto out;
     }
+    /* shear_modulus: written since G could be given apart from E and nu; absent: isotropic (0) */
+    if (H5Lexists(g, "shear_modulus", H5P_DEFAULT) > 0 && !r_dset(g, "shear_modulus", H5T_NATIVE_DOUBLE, (hsize_t)nm, 0, gmod)) {
+        st = bad(r, "materials/shear_modulus has the wrong shape");
+        goto out;
+    }
     for (int64_t m = 0; m < nm; m++) {
-        dem_material_def md = {e[m], nu[m], rho[m]};
+        dem_material_def md = {e[m], nu[m], rho[m], gmod[m]};
         int id;
         dem_status s = dem_material_create(d, &md, &id);
         if (s != DEM_OK) {
@@ -219,6 +225,7 @@ out:
     free(e);
     free(nu);
     free(rho);
+    free(gmod);
     free(pairs);
     free(model);
     free(eidx);

@@ -20,7 +20,7 @@ double dem_rayleigh_time(dem_domain *d)
     double tmin = INFINITY;
     for (int64_t i = 0; i < d->n; i++) {
         const dem_material_def *m = &d->materials[d->mat[i]];
-        double g = m->youngs_modulus / (2.0 * (1.0 + m->poisson_ratio));
+        double g = dem_material_shear_modulus(m);
         double t = DEM_PI * d->radius[i] * sqrt(m->density / g) / (0.1631 * m->poisson_ratio + 0.8766);
         if (t < tmin) tmin = t;
     }

@@ -152,10 +152,11 @@ class Domain:
 
     # ---- materials and pairs ---------------------------------------------------------------
     def add_material(self, youngs_modulus: float | None = None, poisson_ratio: float | None = None,
-                     density: float | None = None) -> int:
-        """A material (None: libdem's default, dem_default_material_def: E 5 MPa, nu 0.25, 2500 kg/m^3)."""
+                     density: float | None = None, shear_modulus: float | None = None) -> int:
+        """A material (None: libdem's default, dem_default_material_def: E 5 MPa, nu 0.25, 2500 kg/m^3,
+        isotropic: G = E / (2 (1 + nu))); shear_modulus gives G apart from E and nu."""
         m = c_definition(lib.dem_default_material_def, "dem_material_def *", youngs_modulus=youngs_modulus,
-                         poisson_ratio=poisson_ratio, density=density)
+                         poisson_ratio=poisson_ratio, density=density, shear_modulus=shear_modulus)
         out = ffi.new("int *")
         self._check(lib.dem_material_create(self._d, m, out))
         return out[0]

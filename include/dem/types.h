@@ -30,6 +30,8 @@ typedef struct dem_material_def {
     double youngs_modulus; /* E, Pa (> 0) */
     double poisson_ratio;  /* nu, in (-1, 0.5) */
     double density;        /* kg/m^3 (> 0); ignored for wall materials */
+    double shear_modulus;  /* G, Pa (> 0), for a material whose G is not E / (2 (1 + nu));
+                            * 0 (the default): isotropic, G = E / (2 (1 + nu)) */
 } dem_material_def;
 
 /* Rolling resistance model; every model caps |M_r| <= mu_r R* |F_n|. */
