@@ -1,5 +1,6 @@
 /* Domain life cycle, settings, profile, state hash and memory accounting. */
 #include "pair_batch.h"
+#include "alloc.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,11 +80,12 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
         if (msg && msg_size) snprintf(msg, msg_size, "dem_domain_create: %s", why);
         return DEM_ERR_INVALID_ARGUMENT;
     }
-    dem_domain *d = calloc(1, sizeof *d);
+    dem_domain *d = dem_calloc(1, sizeof *d);
     if (!d) {
         if (msg && msg_size) snprintf(msg, msg_size, "dem_domain_create: out of memory");
         return DEM_ERR_NO_MEMORY;
     }
+    dem_live_objects(+1);
     d->def = *def;
     d->rayleigh_cache = -1.0;
     d->need_rebuild = 1;
@@ -94,52 +96,53 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
 
 static void free_pair_list(pair_list *p)
 {
-    free(p->start);
-    free(p->active);
-    free(p->j);
-    free(p->image);
-    free(p->hist);
+    dem_free(p->start);
+    dem_free(p->active);
+    dem_free(p->j);
+    dem_free(p->image);
+    dem_free(p->hist);
 }
 
 static void free_wall_list(wall_list *w)
 {
-    free(w->start);
-    free(w->wall);
-    free(w->xi);
-    free(w->mr);
-    free(w->force);
+    dem_free(w->start);
+    dem_free(w->wall);
+    dem_free(w->xi);
+    dem_free(w->mr);
+    dem_free(w->force);
 }
 
 void dem_domain_destroy(dem_domain *d)
 {
     if (!d) return;
-    free(d->materials);
-    free(d->pairs);
+    dem_free(d->materials);
+    dem_free(d->pairs);
     double *dbl[] = {d->x, d->v, d->w, d->f, d->t, d->x_build, d->radius, d->inv_mass, d->inv_inertia};
-    for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++) free(dbl[k]);
-    free(d->mat);
-    free(d->id);
-    free(d->index_of_id);
-    free(d->walls);
+    for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++) dem_free(dbl[k]);
+    dem_free(d->mat);
+    dem_free(d->id);
+    dem_free(d->index_of_id);
+    dem_free(d->walls);
     dem_mesh_free_all(d);
     dem_neighbor_free_scratch(d);
     free_pair_list(&d->pairs_cur);
     free_pair_list(&d->pairs_old);
     free_wall_list(&d->walls_cur);
     free_wall_list(&d->walls_old);
-    free(d->slot);
-    free(d->trans_start);
-    free(d->trans_entry);
-    free(d->entry_row);
-    free(d->cell_of);
-    free(d->trans_lo);
-    free(d->deferred);
-    free(d->trans_hi);
-    free(d->is_direct);
-    free(d->cell_start);
-    free(d->perm);
-    free(d->cursor);
-    free(d);
+    dem_free(d->slot);
+    dem_free(d->trans_start);
+    dem_free(d->trans_entry);
+    dem_free(d->entry_row);
+    dem_free(d->cell_of);
+    dem_free(d->trans_lo);
+    dem_free(d->deferred);
+    dem_free(d->trans_hi);
+    dem_free(d->is_direct);
+    dem_free(d->cell_start);
+    dem_free(d->perm);
+    dem_free(d->cursor);
+    dem_free(d);
+    dem_live_objects(-1);
 }
 
 dem_status dem_domain_get_def(const dem_domain *d, dem_domain_def *def)

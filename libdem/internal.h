@@ -3,6 +3,7 @@
 #define DEM_INTERNAL_H
 
 #include "dem/dem.h"
+#include "alloc.h"
 #include <math.h>
 #include <stdarg.h>
 
@@ -200,6 +201,7 @@ struct dem_domain {
     double rayleigh_cache;    /* < 0: stale */
     int forces_valid;         /* f/t belong to the current state */
 };
+
 
 /* error reporting: sets the message, returns status */
 dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)

@@ -85,8 +85,8 @@ dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *
     dem_material_def *mats = dem_realloc_array(NULL, (size_t)n, sizeof *mats);
     pair_props *pairs = dem_realloc_array(NULL, (size_t)n * n, sizeof *pairs);
     if (!mats || !pairs) {
-        free(mats);
-        free(pairs);
+        dem_free(mats);
+        dem_free(pairs);
         return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_material_create: out of memory");
     }
     if (n_old) memcpy(mats, d->materials, (size_t)n_old * sizeof *mats);
@@ -101,8 +101,8 @@ dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *
                 p->def = dem_default_pair_def();
             }
         }
-    free(d->materials);
-    free(d->pairs);
+    dem_free(d->materials);
+    dem_free(d->pairs);
     d->materials = mats;
     d->pairs = pairs;
     d->n_materials = n;

@@ -64,7 +64,7 @@ dem_status dem_mesh_wall_add_stl(dem_domain *d, const char *path, const dem_mesh
     char what[300];
     snprintf(what, sizeof what, "dem_mesh_wall_add_stl: '%s'", path);
     s = dem_mesh_build(d, soup.xyz, soup.n, def->weld_tolerance, &m, what);
-    free(soup.xyz);
+    dem_free(soup.xyz);
     if (s != DEM_OK) return s;
     m.material = def->material;
     return add_built_mesh(d, &m, what, out);
@@ -88,13 +88,13 @@ dem_status dem_mesh_wall_add(dem_domain *d, int64_t n_vertices, const double *ve
         if (triangles[k] < 0 || triangles[k] >= n_vertices)
             return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "%s: triangle %lld names vertex %d (of %lld)", fn,
                             (long long)(k / 3), triangles[k], (long long)n_vertices);
-    double *corner = malloc((size_t)n_triangles * 9 * sizeof(double));
+    double *corner = dem_malloc((size_t)n_triangles * 9 * sizeof(double));
     if (!corner) return dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", fn);
     for (int64_t k = 0; k < 3 * n_triangles; k++) memcpy(corner + 3 * k, vertices + 3 * (int64_t)triangles[k], 3 * sizeof(double));
     transform_corners(corner, 3 * n_triangles, def);
     mesh_wall m;
     s = dem_mesh_build(d, corner, n_triangles, def->weld_tolerance, &m, fn);
-    free(corner);
+    dem_free(corner);
     if (s != DEM_OK) return s;
     m.material = def->material;
     return add_built_mesh(d, &m, fn, out);

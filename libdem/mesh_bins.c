@@ -73,7 +73,7 @@ static dem_status bin_mesh(dem_domain *d, mesh_wall *m, double reach, double mar
     const double r = reach + margin;
     m->bin_reach = 0.0; /* not valid until done */
     int32_t *st = dem_realloc_array(m->bin_start, (size_t)d->n_cells + 1, sizeof *st);
-    double *xb = m->x_binned ? m->x_binned : malloc((size_t)m->nv * 3 * sizeof(double));
+    double *xb = m->x_binned ? m->x_binned : dem_malloc((size_t)m->nv * 3 * sizeof(double));
     if (st) m->bin_start = st;
     if (xb) m->x_binned = xb;
     if (!st || !xb) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory for the mesh bins");

@@ -18,8 +18,8 @@ static int hmap_init(hmap *h, int64_t n)
 {
     uint64_t cap = 16;
     while (cap < 2 * (uint64_t)n) cap *= 2;
-    h->keys = malloc(cap * 3 * sizeof(int64_t));
-    h->val = malloc(cap * sizeof(int32_t));
+    h->keys = dem_malloc(cap * 3 * sizeof(int64_t));
+    h->val = dem_malloc(cap * sizeof(int32_t));
     h->mask = cap - 1;
     if (!h->keys || !h->val) return 0;
     for (uint64_t k = 0; k < cap; k++) h->val[k] = -1;
@@ -28,8 +28,8 @@ static int hmap_init(hmap *h, int64_t n)
 
 static void hmap_free(hmap *h)
 {
-    free(h->keys);
-    free(h->val);
+    dem_free(h->keys);
+    dem_free(h->val);
 }
 
 /* Slot of key (a, b, c): the one holding it, or the empty one where it would go. */
@@ -55,35 +55,35 @@ static void hmap_put(hmap *h, uint64_t s, int64_t a, int64_t b, int64_t c, int32
 /* ---- building ------------------------------------------------------------------------ */
 void dem_mesh_free(mesh_wall *m)
 {
-    free(m->x_ref);
-    free(m->x);
-    free(m->x_build);
-    free(m->tri);
-    free(m->tri_edge);
-    free(m->edge_ntri);
-    free(m->normal);
-    free(m->bin_start);
-    free(m->bin_tri);
-    free(m->x_binned);
+    dem_free(m->x_ref);
+    dem_free(m->x);
+    dem_free(m->x_build);
+    dem_free(m->tri);
+    dem_free(m->tri_edge);
+    dem_free(m->edge_ntri);
+    dem_free(m->normal);
+    dem_free(m->bin_start);
+    dem_free(m->bin_tri);
+    dem_free(m->x_binned);
     memset(m, 0, sizeof *m);
 }
 
 void dem_mesh_free_all(dem_domain *d)
 {
     for (int k = 0; k < d->n_meshes; k++) dem_mesh_free(&d->meshes[k]);
-    free(d->meshes);
-    free(d->mesh_scratch);
+    dem_free(d->meshes);
+    dem_free(d->mesh_scratch);
     tri_list *tl[2] = {&d->tris_cur, &d->tris_old};
     for (int k = 0; k < 2; k++) {
-        free(tl[k]->start);
-        free(tl[k]->mesh);
-        free(tl[k]->tri);
-        free(tl[k]->active);
-        free(tl[k]->hist);
-        free(tl[k]->force);
-        free(tl[k]->torque);
-        free(tl[k]->point);
-        free(tl[k]->normal);
+        dem_free(tl[k]->start);
+        dem_free(tl[k]->mesh);
+        dem_free(tl[k]->tri);
+        dem_free(tl[k]->active);
+        dem_free(tl[k]->hist);
+        dem_free(tl[k]->force);
+        dem_free(tl[k]->torque);
+        dem_free(tl[k]->point);
+        dem_free(tl[k]->normal);
     }
 }
 
@@ -113,9 +113,9 @@ dem_status dem_mesh_build(dem_domain *d, const double *corner, int64_t n, double
                         diag);
 
     /* weld: vertices hashed by the tolerance cell, matched against the 27 cells around */
-    int32_t *vmap = malloc((size_t)(3 * n) * sizeof(int32_t));
-    int32_t *next = malloc((size_t)(3 * n) * sizeof(int32_t));
-    double *vx = malloc((size_t)(3 * n) * 3 * sizeof(double));
+    int32_t *vmap = dem_malloc((size_t)(3 * n) * sizeof(int32_t));
+    int32_t *next = dem_malloc((size_t)(3 * n) * sizeof(int32_t));
+    double *vx = dem_malloc((size_t)(3 * n) * 3 * sizeof(double));
     hmap cells;
     int ok_cells = hmap_init(&cells, 3 * n);
     dem_status st = DEM_OK;
@@ -150,7 +150,7 @@ dem_status dem_mesh_build(dem_domain *d, const double *corner, int64_t n, double
     }
 
     /* keep triangles with three distinct vertices and a non-zero area */
-    m->tri = malloc((size_t)(3 * n) * sizeof(int32_t));
+    m->tri = dem_malloc((size_t)(3 * n) * sizeof(int32_t));
     if (!m->tri) {
         st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
         goto done;
@@ -187,7 +187,7 @@ dem_status dem_mesh_build(dem_domain *d, const double *corner, int64_t n, double
         if (vmap[v] < 0) vmap[v] = used++;
     }
     m->nv = used;
-    m->x_ref = malloc((size_t)used * 3 * sizeof(double));
+    m->x_ref = dem_malloc((size_t)used * 3 * sizeof(double));
     if (!m->x_ref) {
         st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
         goto done;
@@ -198,9 +198,9 @@ dem_status dem_mesh_build(dem_domain *d, const double *corner, int64_t n, double
     if (!dem_mesh_finish(m)) st = dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", what);
 
 done:
-    free(vmap);
-    free(next);
-    free(vx);
+    dem_free(vmap);
+    dem_free(next);
+    dem_free(vx);
     hmap_free(&cells);
     if (st != DEM_OK) dem_mesh_free(m);
     return st;
@@ -210,11 +210,11 @@ done:
 int dem_mesh_finish(mesh_wall *m)
 {
     const int64_t nt = m->nt;
-    m->x = malloc((size_t)m->nv * 3 * sizeof(double));
-    m->x_build = malloc((size_t)m->nv * 3 * sizeof(double));
-    m->normal = malloc((size_t)nt * 3 * sizeof(double));
-    m->tri_edge = malloc((size_t)nt * 3 * sizeof(int32_t));
-    m->edge_ntri = malloc((size_t)nt * 3 * sizeof(int32_t)); /* at most 3 nt edges */
+    m->x = dem_malloc((size_t)m->nv * 3 * sizeof(double));
+    m->x_build = dem_malloc((size_t)m->nv * 3 * sizeof(double));
+    m->normal = dem_malloc((size_t)nt * 3 * sizeof(double));
+    m->tri_edge = dem_malloc((size_t)nt * 3 * sizeof(int32_t));
+    m->edge_ntri = dem_malloc((size_t)nt * 3 * sizeof(int32_t)); /* at most 3 nt edges */
     hmap edges;
     if (!m->x || !m->x_build || !m->normal || !m->tri_edge || !m->edge_ntri || !hmap_init(&edges, 3 * nt)) return 0;
     /* edges: (min, max) vertex pair -> id */

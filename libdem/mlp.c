@@ -1,5 +1,6 @@
 /* MLP weights files ("dem-mlp 1", written by pydem nn/export.py) and the reference evaluation. */
 #include "mlp_internal.h"
+#include "alloc.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,10 +23,11 @@ void dem_mlp_free(dem_mlp *net)
 {
     if (!net)
         return;
-    free(net->w1);
-    free(net->b1);
-    free(net->w2);
-    free(net);
+    dem_free(net->w1);
+    dem_free(net->b1);
+    dem_free(net->w2);
+    dem_free(net);
+    dem_live_objects(-1);
 }
 
 /* Reads exactly `count` numbers from the rest of a line; strtod reads C99 hex floats exactly. */
@@ -145,9 +147,9 @@ static int parse_line(dem_mlp *m, const char *key, size_t klen, const char *rest
             return 0;
         }
         m->nhid = (int)h;
-        m->w1 = calloc((size_t)m->nhid * (size_t)m->nin, sizeof(double));
-        m->b1 = calloc((size_t)m->nhid, sizeof(double));
-        m->w2 = calloc((size_t)m->nhid, sizeof(double));
+        m->w1 = dem_calloc((size_t)m->nhid * (size_t)m->nin, sizeof(double));
+        m->b1 = dem_calloc((size_t)m->nhid, sizeof(double));
+        m->w2 = dem_calloc((size_t)m->nhid, sizeof(double));
         if (!m->w1 || !m->b1 || !m->w2) {
             dem_mlp_set_error(err, err_size, "out of memory for %d hidden units", m->nhid);
             return -1;
@@ -177,9 +179,10 @@ dem_status dem_mlp_parse(const char *text, dem_mlp **out, char *err, size_t err_
         return DEM_ERR_NULL;
     }
     *out = NULL;
-    m = calloc(1, sizeof *m);
+    m = dem_calloc(1, sizeof *m);
     if (!m)
         return DEM_ERR_NO_MEMORY;
+    dem_live_objects(+1); /* dem_mlp_free counts it down */
     while (*p) {
         size_t len = strcspn(p, "\n"), klen;
         char *rest, *dyn = NULL, *s;
@@ -187,7 +190,7 @@ dem_status dem_mlp_parse(const char *text, dem_mlp **out, char *err, size_t err_
         ++line;
         /* long lines (big nets) go to the heap */
         if (len >= sizeof buf) {
-            dyn = malloc(len + 1);
+            dyn = dem_malloc(len + 1);
             if (!dyn) {
                 dem_mlp_free(m);
                 return DEM_ERR_NO_MEMORY;
@@ -201,14 +204,14 @@ dem_status dem_mlp_parse(const char *text, dem_mlp **out, char *err, size_t err_
             ++s;
         klen = strcspn(s, " \t\r");
         if (klen == 0 || s[0] == '#') {
-            free(dyn);
+            dem_free(dyn);
             continue;
         }
         rest = s + klen;
         while (*rest == ' ' || *rest == '\t')
             ++rest;
         bit = parse_line(m, s, klen, rest, seen, line, err, err_size);
-        free(dyn);
+        dem_free(dyn);
         if (bit <= 0) {
             dem_mlp_free(m);
             return bit < 0 ? DEM_ERR_NO_MEMORY : DEM_ERR_FORMAT;
@@ -259,14 +262,14 @@ dem_status dem_mlp_load(const char *path, dem_mlp **out, char *err, size_t err_s
         fclose(fp);
         return DEM_ERR_IO;
     }
-    text = malloc((size_t)size + 1);
+    text = dem_malloc((size_t)size + 1);
     if (!text) {
         fclose(fp);
         return DEM_ERR_NO_MEMORY;
     }
     if (fread(text, 1, (size_t)size, fp) != (size_t)size) {
         dem_mlp_set_error(err, err_size, "%s: read error", path);
-        free(text);
+        dem_free(text);
         fclose(fp);
         return DEM_ERR_IO;
     }
@@ -274,11 +277,11 @@ dem_status dem_mlp_load(const char *path, dem_mlp **out, char *err, size_t err_s
     text[size] = '\0';
     if (strlen(text) != (size_t)size) {
         dem_mlp_set_error(err, err_size, "%s: binary data (NUL byte) in a text weights file", path);
-        free(text);
+        dem_free(text);
         return DEM_ERR_FORMAT;
     }
     st = dem_mlp_parse(text, out, err, err_size);
-    free(text);
+    dem_free(text);
     if (st == DEM_ERR_FORMAT && err && err_size) { /* prefix the file name */
         char tmp[512];
         snprintf(tmp, sizeof tmp, "%s: %s", path, err);

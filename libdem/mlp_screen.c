@@ -3,6 +3,7 @@
  * vectorisable loop over the block; tanh is evaluated by fast_tanh (below), accurate to a few
  * ulp, because libm's tanh does not vectorise and would dominate the cost. */
 #include "mlp_internal.h"
+#include "alloc.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -97,7 +98,7 @@ dem_status dem_mlp_eval_many(const dem_mlp *m, const double *x, size_t n, double
     nblocks = (long)((n + BLOCK - 1) / BLOCK);
 #pragma omp parallel num_threads(num_threads > 0 ? num_threads : omp_get_max_threads())
     {
-        double *xs = malloc(sizeof(double) * BLOCK * (size_t)m->nin);
+        double *xs = dem_malloc(sizeof(double) * BLOCK * (size_t)m->nin);
         if (!xs) {
 #pragma omp atomic write
             st = DEM_ERR_NO_MEMORY;
@@ -109,7 +110,7 @@ dem_status dem_mlp_eval_many(const dem_mlp *m, const double *x, size_t n, double
             if (xs)
                 eval_block(m, x + start * (size_t)m->nin, nb, xs, y + start);
         }
-        free(xs);
+        dem_free(xs);
     }
     return st;
 }
@@ -151,7 +152,7 @@ dem_status dem_mlp_screen(const dem_mlp *const *nets, int num_nets, const double
     nblocks = (long)((n + BLOCK - 1) / BLOCK);
 #pragma omp parallel num_threads(num_threads > 0 ? num_threads : omp_get_max_threads()) reduction(+ : kept, failed)
     {
-        double *xs = malloc(sizeof(double) * BLOCK * (size_t)nets[0]->nin);
+        double *xs = dem_malloc(sizeof(double) * BLOCK * (size_t)nets[0]->nin);
         double pred[BLOCK];
         unsigned char ok[BLOCK];
         failed += xs == NULL;
@@ -176,7 +177,7 @@ dem_status dem_mlp_screen(const dem_mlp *const *nets, int num_nets, const double
                 kept += ok[b];
             }
         }
-        free(xs);
+        dem_free(xs);
     }
     if (failed) {
         dem_mlp_set_error(err, err_size, "dem_mlp_screen: out of memory for the thread scratch");

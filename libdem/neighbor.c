@@ -140,10 +140,10 @@ void dem_neighbor_free_scratch(dem_domain *d)
 {
     scan_buffer *b = d->scan;
     for (int p = 0; p < d->n_scan; p++) {
-        free(b[p].j);
-        free(b[p].image);
+        dem_free(b[p].j);
+        dem_free(b[p].image);
     }
-    free(d->scan);
+    dem_free(d->scan);
     d->scan = NULL;
     d->n_scan = 0;
 }

@@ -70,9 +70,9 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
         g.size[a] = (d->def.hi[a] - d->def.lo[a]) / g.n[a];
     }
     const int *nc = g.n;
-    int32_t *cellc = malloc((size_t)total * 3 * sizeof *cellc);
+    int32_t *cellc = dem_malloc((size_t)total * 3 * sizeof *cellc);
     if (!cellc || !cell_grid_alloc(&g, total)) {
-        free(cellc);
+        dem_free(cellc);
         *no_memory = 1;
         return -1;
     }
@@ -132,7 +132,7 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
 #undef P
 #undef R
     cell_grid_free(&g);
-    free(cellc);
+    dem_free(cellc);
     return found;
 }
 
@@ -234,20 +234,20 @@ dem_status dem_particles_remove(dem_domain *d, int64_t n, const dem_particle_id 
     if (n < 0) return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_particles_remove: count must be >= 0");
     if (n == 0) return DEM_OK;
     if (!ids) return dem_fail(d, DEM_ERR_NULL, "dem_particles_remove: ids must not be NULL");
-    unsigned char *mask = calloc((size_t)d->n + 1, 1);
+    unsigned char *mask = dem_calloc((size_t)d->n + 1, 1);
     if (!mask) return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_particles_remove: out of memory");
     for (int64_t k = 0; k < n; k++) {
         dem_particle_id id = ids[k];
         int32_t i = (id >= 0 && id < d->next_id) ? d->index_of_id[id] : -1;
         if (i < 0 || mask[i]) {
-            free(mask);
+            dem_free(mask);
             return dem_fail(d, DEM_ERR_UNKNOWN_PARTICLE, "dem_particles_remove: id %lld is not a live particle%s",
                             (long long)id, i >= 0 ? " (listed twice)" : "");
         }
         mask[i] = 1;
     }
     dem_status s = dem_neighbor_rebuild(d, mask);
-    free(mask);
+    dem_free(mask);
     if (s != DEM_OK) return s;
     d->forces_valid = 0;
     d->rayleigh_cache = -1.0;

@@ -74,7 +74,7 @@ static void draw_walls(const dem_domain *d, unsigned char *rgb, const view *v)
     }
     for (int k = 0; k < d->n_meshes; k++) { /* boundary edges and sharp (> 20 degree) edges */
         const mesh_wall *m = &d->meshes[k];
-        int32_t *first = malloc((size_t)m->ne * 2 * sizeof(int32_t) + 8);
+        int32_t *first = dem_malloc((size_t)m->ne * 2 * sizeof(int32_t) + 8);
         if (!first) return;
         int32_t *second = first + m->ne;
         for (int64_t e = 0; e < m->ne; e++) first[e] = second[e] = -1;
@@ -97,7 +97,7 @@ static void draw_walls(const dem_domain *d, unsigned char *rgb, const view *v)
                 const double *a = m->x + 3 * m->tri[3 * t + q], *b = m->x + 3 * m->tri[3 * t + (q + 1) % 3];
                 draw_line(rgb, v, a[v->ax_u], a[v->ax_v], b[v->ax_u], b[v->ax_v], c);
             }
-        free(first);
+        dem_free(first);
     }
 }
 
@@ -131,12 +131,12 @@ dem_status dem_render_rgb(dem_domain *d, const dem_render_def *def, unsigned cha
     }
     v.sx = v.w / (v.hi[0] - v.lo[0]);
     v.sy = v.h / (v.hi[1] - v.lo[1]);
-    float *depth = malloc((size_t)v.w * v.h * sizeof(float));
+    float *depth = dem_malloc((size_t)v.w * v.h * sizeof(float));
     double *value = NULL;
-    if (def->color_mode == DEM_COLOR_SCALAR) value = malloc((size_t)(d->n + 1) * sizeof(double));
+    if (def->color_mode == DEM_COLOR_SCALAR) value = dem_malloc((size_t)(d->n + 1) * sizeof(double));
     if (!depth || (def->color_mode == DEM_COLOR_SCALAR && !value)) {
-        free(depth);
-        free(value);
+        dem_free(depth);
+        dem_free(value);
         return dem_fail(d, DEM_ERR_NO_MEMORY, "%s: out of memory", fn);
     }
     if (value) { /* the caller's array is in ascending id order */
@@ -182,8 +182,8 @@ dem_status dem_render_rgb(dem_domain *d, const dem_render_def *def, unsigned cha
         }
     }
     if (def->draw_walls) draw_walls(d, rgb, &v);
-    free(depth);
-    free(value);
+    dem_free(depth);
+    dem_free(value);
     dem_clear_error(d);
     return DEM_OK;
 }
@@ -194,16 +194,16 @@ static int write_png(FILE *fp, const unsigned char *rgb, int w, int h)
 {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
     png_infop info = png ? png_create_info_struct(png) : NULL;
-    png_bytep *rows = malloc((size_t)h * sizeof *rows);
+    png_bytep *rows = dem_malloc((size_t)h * sizeof *rows);
     if (!png || !info || !rows) {
         png_destroy_write_struct(&png, &info);
-        free(rows);
+        dem_free(rows);
         return 0;
     }
     for (int y = 0; y < h; y++) rows[y] = (png_bytep)(rgb + (size_t)y * w * 3);
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
-        free(rows);
+        dem_free(rows);
         return 0;
     }
     png_init_io(png, fp);
@@ -214,7 +214,7 @@ static int write_png(FILE *fp, const unsigned char *rgb, int w, int h)
     png_write_image(png, rows);
     png_write_end(png, NULL);
     png_destroy_write_struct(&png, &info);
-    free(rows);
+    dem_free(rows);
     return 1;
 }
 
@@ -233,20 +233,20 @@ dem_status dem_render_png(dem_domain *d, const dem_render_def *def, const char *
     if (def->width < 1 || def->height < 1 || def->width > 16384 || def->height > 16384)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_render_png: image size must be 1..16384 pixels, got %d x %d",
                         def->width, def->height);
-    unsigned char *rgb = malloc((size_t)def->width * def->height * 3);
+    unsigned char *rgb = dem_malloc((size_t)def->width * def->height * 3);
     if (!rgb) return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_render_png: out of memory");
     dem_status s = dem_render_rgb(d, def, rgb);
     if (s != DEM_OK) {
-        free(rgb);
+        dem_free(rgb);
         return s;
     }
     FILE *fp = fopen(path, "wb");
     if (!fp) {
-        free(rgb);
+        dem_free(rgb);
         return dem_fail(d, DEM_ERR_IO, "dem_render_png: cannot create '%s'", path);
     }
     int ok = write_png(fp, rgb, def->width, def->height);
-    free(rgb);
+    dem_free(rgb);
     ok = (fclose(fp) == 0) && ok;
     if (!ok) return dem_fail(d, DEM_ERR_IO, "dem_render_png: writing '%s' failed", path);
     dem_clear_error(d);

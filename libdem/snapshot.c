@@ -105,8 +105,8 @@ static int write_materials(hid_t f, const dem_domain *d)
     const size_t np = (size_t)nm * nm;
     hid_t g = H5Gcreate2(f, "materials", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (g < 0) return 0;
-    double *buf = malloc((np > (size_t)nm ? np : (size_t)nm) * 5 * sizeof(double) + 8);
-    int32_t *ibuf = malloc(np * sizeof(int32_t) + 4);
+    double *buf = dem_malloc((np > (size_t)nm ? np : (size_t)nm) * 5 * sizeof(double) + 8);
+    int32_t *ibuf = dem_malloc(np * sizeof(int32_t) + 4);
     int ok = buf && ibuf;
     static const char *const field[4] = {"youngs_modulus", "poisson_ratio", "density", "shear_modulus"};
     for (int k = 0; ok && k < 4; k++) {
@@ -129,8 +129,8 @@ static int write_materials(hid_t f, const dem_domain *d)
     /* effects: rows (a, b, effect index) + parameters; effect names as an attribute */
     int64_t ne = 0;
     for (size_t p = 0; p < np; p++) ne += d->pairs[p].n_effects;
-    int32_t *eidx = malloc((size_t)ne * 3 * sizeof(int32_t) + 4);
-    double *epar = malloc((size_t)ne * DEM_MAX_EFFECT_PARAMS * sizeof(double) + 8);
+    int32_t *eidx = dem_malloc((size_t)ne * 3 * sizeof(int32_t) + 4);
+    double *epar = dem_malloc((size_t)ne * DEM_MAX_EFFECT_PARAMS * sizeof(double) + 8);
     ok = ok && eidx && epar;
     int64_t r = 0;
     for (size_t p = 0; ok && p < np; p++)
@@ -148,10 +148,10 @@ static int write_materials(hid_t f, const dem_domain *d)
         strncat(names, dem_effect_get(e)->name, sizeof names - strlen(names) - 1);
     }
     ok = ok && w_attr_str(g, "effect_names", names);
-    free(buf);
-    free(ibuf);
-    free(eidx);
-    free(epar);
+    dem_free(buf);
+    dem_free(ibuf);
+    dem_free(eidx);
+    dem_free(epar);
     H5Gclose(g);
     return ok;
 }
@@ -176,8 +176,8 @@ static int write_walls(hid_t f, const dem_domain *d)
     hid_t g = H5Gcreate2(f, "walls", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (g < 0) return 0;
     const int nw = d->n_walls;
-    int32_t *iv = malloc((size_t)(nw + 1) * 3 * sizeof(int32_t));
-    double *dv = malloc((size_t)(nw + 1) * 4 * sizeof(double));
+    int32_t *iv = dem_malloc((size_t)(nw + 1) * 3 * sizeof(int32_t));
+    double *dv = dem_malloc((size_t)(nw + 1) * 4 * sizeof(double));
     int ok = iv && dv;
     for (int w = 0; ok && w < nw; w++) {
         const dem_plane_wall_def *p = &d->walls[w].def;
@@ -218,8 +218,8 @@ static int write_walls(hid_t f, const dem_domain *d)
              w_attr(mg, "servo_force", H5T_NATIVE_DOUBLE, 1, &m->servo_force);
         H5Gclose(mg);
     }
-    free(iv);
-    free(dv);
+    dem_free(iv);
+    dem_free(dv);
     H5Gclose(g);
     return ok;
 }
@@ -240,9 +240,9 @@ static int write_contacts(hid_t f, const dem_domain *d)
     const wall_list *wl = &d->walls_cur;
     const tri_list *tl = &d->tris_cur;
     int64_t cap = pl->count + wl->count + tl->count + 1;
-    int64_t *ids = malloc((size_t)cap * 2 * sizeof(int64_t));
-    int32_t *iv = malloc((size_t)cap * 3 * sizeof(int32_t));
-    double *h = malloc((size_t)cap * 15 * sizeof(double));
+    int64_t *ids = dem_malloc((size_t)cap * 2 * sizeof(int64_t));
+    int32_t *iv = dem_malloc((size_t)cap * 3 * sizeof(int32_t));
+    double *h = dem_malloc((size_t)cap * 15 * sizeof(double));
     int ok = ids && iv && h;
     int64_t r = 0;
     for (int64_t i = 0; ok && i < d->n; i++)
@@ -289,9 +289,9 @@ static int write_contacts(hid_t f, const dem_domain *d)
     ok = ok && w_dset(g, "mesh_ids", H5T_NATIVE_INT64, (hsize_t)r, 0, ids) &&
          w_dset(g, "mesh_mesh_triangle_active", H5T_NATIVE_INT32, (hsize_t)r, 3, iv) &&
          w_dset(g, "mesh_history_force_point_normal", H5T_NATIVE_DOUBLE, (hsize_t)r, 15, h);
-    free(ids);
-    free(iv);
-    free(h);
+    dem_free(ids);
+    dem_free(iv);
+    dem_free(h);
     H5Gclose(g);
     return ok;
 }

@@ -138,12 +138,12 @@ static dem_status read_materials(reader *r)
         goto out;
     }
     const size_t np = (size_t)nm * (size_t)nm;
-    e = malloc((size_t)nm * sizeof *e + 8);
-    nu = malloc((size_t)nm * sizeof *nu + 8);
-    rho = malloc((size_t)nm * sizeof *rho + 8);
-    gmod = calloc((size_t)nm + 1, sizeof *gmod);
-    pairs = malloc(np * 4 * sizeof *pairs + 8);
-    model = malloc(np * sizeof *model + 4);
+    e = dem_malloc((size_t)nm * sizeof *e + 8);
+    nu = dem_malloc((size_t)nm * sizeof *nu + 8);
+    rho = dem_malloc((size_t)nm * sizeof *rho + 8);
+    gmod = dem_calloc((size_t)nm + 1, sizeof *gmod);
+    pairs = dem_malloc(np * 4 * sizeof *pairs + 8);
+    model = dem_malloc(np * sizeof *model + 4);
     if (!e || !nu || !rho || !gmod || !pairs || !model) {
         st = bad(r, "out of memory");
         goto out;
@@ -185,8 +185,8 @@ static dem_status read_materials(reader *r)
         st = bad(r, "materials: effect tables missing");
         goto out;
     }
-    eidx = malloc((size_t)ne * 3 * sizeof *eidx + 4);
-    epar = malloc((size_t)ne * DEM_MAX_EFFECT_PARAMS * sizeof *epar + 8);
+    eidx = dem_malloc((size_t)ne * 3 * sizeof *eidx + 4);
+    epar = dem_malloc((size_t)ne * DEM_MAX_EFFECT_PARAMS * sizeof *epar + 8);
     if (!eidx || !epar || !r_dset(g, "effect_pairs", H5T_NATIVE_INT32, (hsize_t)ne, 3, eidx) ||
         !r_dset(g, "effect_params", H5T_NATIVE_DOUBLE, (hsize_t)ne, DEM_MAX_EFFECT_PARAMS, epar)) {
         st = bad(r, "materials: effect tables malformed");
@@ -222,14 +222,14 @@ static dem_status read_materials(reader *r)
         }
     }
 out:
-    free(e);
-    free(nu);
-    free(rho);
-    free(gmod);
-    free(pairs);
-    free(model);
-    free(eidx);
-    free(epar);
+    dem_free(e);
+    dem_free(nu);
+    dem_free(rho);
+    dem_free(gmod);
+    dem_free(pairs);
+    dem_free(model);
+    dem_free(eidx);
+    dem_free(epar);
     H5Gclose(g);
     return st;
 }
@@ -253,9 +253,9 @@ static dem_status read_mesh(reader *r, hid_t g, int k)
         st = bad(r, "mesh arrays missing");
         goto out;
     }
-    m.x_ref = malloc((size_t)m.nv * 3 * sizeof(double));
-    m.tri = malloc((size_t)m.nt * 3 * sizeof(int32_t));
-    xb = malloc((size_t)m.nv * 3 * sizeof(double));
+    m.x_ref = dem_malloc((size_t)m.nv * 3 * sizeof(double));
+    m.tri = dem_malloc((size_t)m.nt * 3 * sizeof(int32_t));
+    xb = dem_malloc((size_t)m.nv * 3 * sizeof(double));
     if (!m.x_ref || !m.tri || !xb || !r_dset(mg, "vertices_reference", H5T_NATIVE_DOUBLE, (hsize_t)m.nv, 3, m.x_ref) ||
         !r_dset(mg, "triangles", H5T_NATIVE_INT32, (hsize_t)m.nt, 3, m.tri) ||
         !r_dset(mg, "vertices_at_list_build", H5T_NATIVE_DOUBLE, (hsize_t)m.nv, 3, xb) ||
@@ -309,7 +309,7 @@ static dem_status read_mesh(reader *r, hid_t g, int k)
     if (st != DEM_OK) st = lib_fail(r, st);
 out:
     dem_mesh_free(&m);
-    free(xb);
+    dem_free(xb);
     H5Gclose(mg);
     return st;
 }
@@ -321,8 +321,8 @@ static dem_status read_walls(reader *r)
     dem_status st = DEM_OK;
     int64_t nw = r_rows(g, "plane_position_velocity");
     int32_t n_meshes = 0;
-    int32_t *iv = malloc((size_t)(nw > 0 ? nw : 1) * 3 * sizeof(int32_t));
-    double *dv = malloc((size_t)(nw > 0 ? nw : 1) * 4 * sizeof(double));
+    int32_t *iv = dem_malloc((size_t)(nw > 0 ? nw : 1) * 3 * sizeof(int32_t));
+    double *dv = dem_malloc((size_t)(nw > 0 ? nw : 1) * 4 * sizeof(double));
     if (nw < 0 || !iv || !dv || !r_dset(g, "plane_axis_side_material", H5T_NATIVE_INT32, (hsize_t)nw, 3, iv) ||
         !r_dset(g, "plane_position_velocity", H5T_NATIVE_DOUBLE, (hsize_t)nw, 4, dv) ||
         !r_attr(g, "mesh_count", H5T_NATIVE_INT32, 1, &n_meshes) || n_meshes < 0) {
@@ -345,8 +345,8 @@ static dem_status read_walls(reader *r)
     }
     for (int k = 0; k < n_meshes && st == DEM_OK; k++) st = read_mesh(r, g, k);
 out:
-    free(iv);
-    free(dv);
+    dem_free(iv);
+    dem_free(dv);
     H5Gclose(g);
     return st;
 }
@@ -401,8 +401,8 @@ static dem_status rebuild_list(reader *r)
 {
     dem_domain *d = r->d;
     const size_t bytes = (size_t)d->n * 3 * sizeof(double);
-    double *now = malloc(bytes + 8);
-    double **mesh_now = calloc((size_t)d->n_meshes + 1, sizeof *mesh_now);
+    double *now = dem_malloc(bytes + 8);
+    double **mesh_now = dem_calloc((size_t)d->n_meshes + 1, sizeof *mesh_now);
     dem_status st = DEM_OK;
     if (!now || !mesh_now) {
         st = bad(r, "out of memory");
@@ -413,7 +413,7 @@ static dem_status rebuild_list(reader *r)
     for (int k = 0; k < d->n_meshes; k++) { /* meshes at their build place */
         mesh_wall *m = &d->meshes[k];
         mesh_now[k] = m->x;
-        m->x = malloc((size_t)m->nv * 3 * sizeof(double));
+        m->x = dem_malloc((size_t)m->nv * 3 * sizeof(double));
         if (!m->x) {
             m->x = mesh_now[k];
             mesh_now[k] = NULL;
@@ -435,11 +435,11 @@ static dem_status rebuild_list(reader *r)
 out:
     for (int k = 0; k < d->n_meshes; k++)
         if (mesh_now && mesh_now[k]) {
-            free(d->meshes[k].x);
+            dem_free(d->meshes[k].x);
             d->meshes[k].x = mesh_now[k];
         }
-    free(now);
-    free(mesh_now);
+    dem_free(now);
+    dem_free(mesh_now);
     return st;
 }
 
@@ -451,9 +451,9 @@ static dem_status read_contacts(reader *r)
     dem_status st = DEM_OK;
     int64_t np = r_rows(g, "pair_ids"), nw = r_rows(g, "plane_ids"), nm = r_rows(g, "mesh_ids");
     int64_t cap = (np > nw ? np : nw) > nm ? (np > nw ? np : nw) : nm;
-    int64_t *ids = malloc((size_t)(cap + 1) * 2 * sizeof(int64_t));
-    int32_t *iv = malloc((size_t)(cap + 1) * 3 * sizeof(int32_t));
-    double *h = malloc((size_t)(cap + 1) * 15 * sizeof(double));
+    int64_t *ids = dem_malloc((size_t)(cap + 1) * 2 * sizeof(int64_t));
+    int32_t *iv = dem_malloc((size_t)(cap + 1) * 3 * sizeof(int32_t));
+    double *h = dem_malloc((size_t)(cap + 1) * 15 * sizeof(double));
     if (np < 0 || nw < 0 || nm < 0 || !ids || !iv || !h) {
         st = bad(r, "contact tables missing");
         goto out;
@@ -523,9 +523,9 @@ static dem_status read_contacts(reader *r)
     }
 #undef ID_INDEX
 out:
-    free(ids);
-    free(iv);
-    free(h);
+    dem_free(ids);
+    dem_free(iv);
+    dem_free(h);
     H5Gclose(g);
     return st;
 }
@@ -563,8 +563,8 @@ dem_status dem_snapshot_read(const char *path, dem_domain **out, char *msg, size
     if (st == DEM_OK && r.d->n > 0) {
         dem_domain *d = r.d;
         hid_t g = H5Gopen2(r.f, "particles", H5P_DEFAULT);
-        f = malloc((size_t)d->n * 3 * sizeof(double));
-        t = malloc((size_t)d->n * 3 * sizeof(double));
+        f = dem_malloc((size_t)d->n * 3 * sizeof(double));
+        t = dem_malloc((size_t)d->n * 3 * sizeof(double));
         if (g < 0 || !f || !t || !r_dset(g, "force", H5T_NATIVE_DOUBLE, (hsize_t)d->n, 3, f) ||
             !r_dset(g, "torque", H5T_NATIVE_DOUBLE, (hsize_t)d->n, 3, t))
             st = bad(&r, "particles/force or torque missing");
@@ -577,8 +577,8 @@ dem_status dem_snapshot_read(const char *path, dem_domain **out, char *msg, size
             d->forces_valid = 1;
         }
     }
-    free(f);
-    free(t);
+    dem_free(f);
+    dem_free(t);
     if (st == DEM_OK) {
         r.d->step = step;
         r.d->time = time;

@@ -62,7 +62,7 @@ void *dem_realloc_array(void *p, size_t count, size_t elem)
 {
     if (count == 0) count = 1;
     if (count > SIZE_MAX / elem) return NULL;
-    return realloc(p, count * elem);
+    return dem_realloc(p, count * elem);
 }
 
 int dem_reserve_rows(int64_t **start, int64_t *cap, int64_t n)

@@ -4,6 +4,7 @@
  * says what and where (byte offset or line). The parser only ever reads inside the buffer
  * (fuzzed: tests/c/test_stl.c and tests/data/stl_corpus). */
 #include "stl.h"
+#include "alloc.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -27,7 +28,7 @@ static float read_f32le(const unsigned char *p)
 static int parse_binary(const unsigned char *buf, size_t len, stl_soup *out, char *err, size_t errsz)
 {
     uint32_t n = read_u32le(buf + 80);
-    out->xyz = malloc((size_t)(n ? n : 1) * 9 * sizeof(double));
+    out->xyz = dem_malloc((size_t)(n ? n : 1) * 9 * sizeof(double));
     if (!out->xyz) {
         snprintf(err, errsz, "binary STL: out of memory for %u triangles", n);
         return STL_NO_MEMORY;
@@ -122,7 +123,7 @@ static int parse_ascii(const unsigned char *buf, size_t len, stl_soup *out, char
 {
     cursor c = {(const char *)buf, (const char *)buf + len, 1};
     size_t cap = 64, n = 0;
-    out->xyz = malloc(cap * 9 * sizeof(double));
+    out->xyz = dem_malloc(cap * 9 * sizeof(double));
     if (!out->xyz) {
         snprintf(err, errsz, "ASCII STL: out of memory");
         return STL_NO_MEMORY;
@@ -156,7 +157,7 @@ static int parse_ascii(const unsigned char *buf, size_t len, stl_soup *out, char
                 if (!read_number(&c, &normal[k], err, errsz)) return STL_BAD;
             if (!expect(&c, "outer", err, errsz) || !expect(&c, "loop", err, errsz)) return STL_BAD;
             if (n == cap) {
-                double *p = realloc(out->xyz, 2 * cap * 9 * sizeof(double));
+                double *p = dem_realloc(out->xyz, 2 * cap * 9 * sizeof(double));
                 if (!p) {
                     snprintf(err, errsz, "ASCII STL: out of memory");
                     return STL_NO_MEMORY;
@@ -219,7 +220,7 @@ int dem_stl_parse(const unsigned char *buf, size_t len, stl_soup *out, char *err
         rc = STL_BAD;
     }
     if (rc != STL_OK) {
-        free(out->xyz);
+        dem_free(out->xyz);
         out->xyz = NULL;
         out->n = 0;
     }
@@ -240,9 +241,9 @@ int dem_stl_read_file(const char *path, stl_soup *out, char *err, size_t errsz)
     for (;;) {
         if (len == cap) {
             size_t c = cap ? 2 * cap : 1 << 16;
-            unsigned char *p = realloc(buf, c);
+            unsigned char *p = dem_realloc(buf, c);
             if (!p) {
-                free(buf);
+                dem_free(buf);
                 fclose(fp);
                 snprintf(err, errsz, "'%s': out of memory while reading", path);
                 return STL_NO_MEMORY;
@@ -257,13 +258,13 @@ int dem_stl_read_file(const char *path, stl_soup *out, char *err, size_t errsz)
     int read_error = ferror(fp);
     fclose(fp);
     if (read_error) {
-        free(buf);
+        dem_free(buf);
         snprintf(err, errsz, "cannot read '%s' (is it a directory?)", path);
         return STL_IO;
     }
     char inner[400];
     int rc = dem_stl_parse(buf, len, out, inner, sizeof inner);
-    free(buf);
+    dem_free(buf);
     if (rc != STL_OK) snprintf(err, errsz, "'%s': %s", path, inner);
     return rc;
 }

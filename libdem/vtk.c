@@ -100,12 +100,12 @@ dem_status dem_vtk_write_mesh(dem_domain *d, int mesh, const char *path)
         if (s != DEM_OK) return s;
     }
     const int64_t nv = d->meshes[mesh].nv, nt = d->meshes[mesh].nt;
-    double *force = malloc((size_t)(nt > 0 ? nt : 1) * 3 * sizeof(double));
+    double *force = dem_malloc((size_t)(nt > 0 ? nt : 1) * 3 * sizeof(double));
     if (!force) return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_vtk_write_mesh: out of memory");
     dem_mesh_wall_triangle_forces(d, mesh, force, nt);
     FILE *fp = open_vtu(d, path, "dem_vtk_write_mesh", nv, nt);
     if (!fp) {
-        free(force);
+        dem_free(force);
         return DEM_ERR_IO;
     }
     fputs("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n", fp);
@@ -115,6 +115,6 @@ dem_status dem_vtk_write_mesh(dem_domain *d, int mesh, const char *path)
     fputs("<CellData Vectors=\"force\">\n", fp);
     vector_array(fp, "force", force, nt);
     fputs("</CellData>\n", fp);
-    free(force);
+    dem_free(force);
     return close_vtu(d, fp, path, "dem_vtk_write_mesh");
 }

@@ -53,6 +53,18 @@ typedef enum dem_status {
 typedef void (*dem_assert_hook)(const char *expression, const char *file, int line);
 DEM_API void dem_set_assert_hook(dem_assert_hook hook);
 
+/* Where libdem's memory comes from (process-wide): the C library's malloc family by default.
+ * A host application may set its own before it creates a domain (or after destroying the
+ * last one): DEM_ERR_INVALID_ARGUMENT while any domain exists, DEM_ERR_NULL for a missing
+ * function; NULL restores the default. HDF5 and libpng allocate for themselves in file I/O. */
+typedef struct dem_allocator {
+    void *(*malloc)(size_t size);
+    void *(*calloc)(size_t count, size_t size);
+    void *(*realloc)(void *p, size_t size);
+    void (*free)(void *p);
+} dem_allocator;
+DEM_API dem_status dem_set_allocator(const dem_allocator *allocator);
+
 /* Short fixed name of a status ("DEM_ERR_OVERLAP"); never NULL. */
 DEM_API const char *dem_status_name(dem_status status);
 
