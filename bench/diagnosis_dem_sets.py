@@ -58,7 +58,7 @@ def diagnose(args):
         obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"])
                for r in row["rows"] if r["value"] is not None]
         vals = {i: r["value"] for i, r in enumerate(x for x in row["rows"] if x["value"] is not None)}
-        noisy = synthetic._fill(obs, vals, setup.nets, rng)
+        noisy = synthetic.with_lab_noise(obs, vals, setup.nets, rng)
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,

@@ -95,8 +95,10 @@ def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidat
     return Truth(theta, c.name, c.parameter, strength)
 
 
-def _fill(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator) -> list[Observation]:
-    """values: observation index -> the model value before noise (surrogate mean or one DEM run)."""
+def with_lab_noise(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator) -> list[Observation]:
+    """Pseudo-measurements from model values (observation index -> the value before noise: a
+    surrogate mean with seed scatter, or one DEM run): lab noise added, each row's uncertainty
+    the noise and one run's seed scatter combined."""
     out = []
     for i, o in enumerate(obs):
         v = values[i]
@@ -124,7 +126,7 @@ def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np
     """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
     values = surrogate_values(nets, candidates, truth, obs)
     values = {i: v + rng.normal(0.0, nets[o.quantity].seed_sd) for (i, v), o in zip(values.items(), obs)}
-    return _fill(obs, values, nets, rng)
+    return with_lab_noise(obs, values, nets, rng)
 
 
 def signal(setup, truth: Truth, obs: list[Observation]) -> float:
@@ -192,7 +194,7 @@ def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth,
     failed are left out."""
     values = rig_values(stores, truth.inputs(candidates), obs, seed, threads, say)
     keep = sorted(values)
-    return _fill([obs[i] for i in keep], {k: values[i] for k, i in enumerate(keep)}, nets, rng)
+    return with_lab_noise([obs[i] for i in keep], {k: values[i] for k, i in enumerate(keep)}, nets, rng)
 
 
 def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):
