@@ -12,7 +12,8 @@ static const double R = 5e-4, L = 0.006, H = 0.02;
 
 /* Particles and lid of material *mat; the box of a second material whose friction with the
  * particles is wall_friction. */
-static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_friction)
+/* The L x L x H domain (dt 5 us) with one material *mat, restitution 0.2, friction 0.3. */
+static dem_domain *column_domain(int *mat)
 {
     dem_domain_def def = dem_default_domain_def();
     for (int a = 0; a < 3; a++) {
@@ -29,6 +30,15 @@ static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_frict
     p.restitution = 0.2;
     p.friction = 0.3;
     assert_ok(dem_pair_set(d, *mat, *mat, &p));
+    return d;
+}
+
+static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_friction)
+{
+    dem_domain *d = column_domain(mat);
+    dem_material_def md = dem_default_material_def();
+    dem_pair_def p = dem_default_pair_def();
+    p.restitution = 0.2;
     int wall_mat;
     assert_ok(dem_material_create(d, &md, &wall_mat));
     p.friction = wall_friction;
@@ -145,22 +155,8 @@ static void test_mean_wall_force(void **state)
 static void test_plane_wall_mean_force(void **state)
 {
     (void)state;
-    dem_domain_def def = dem_default_domain_def();
-    for (int a = 0; a < 3; a++) {
-        def.lo[a] = -0.001;
-        def.hi[a] = (a == 2 ? H : L) + 0.001;
-    }
-    def.dt = 5e-6;
-    dem_domain *d;
-    char msg[256];
-    assert_ok(dem_domain_create(&def, &d, msg, sizeof msg));
-    dem_material_def md = dem_default_material_def();
     int mat, floor_wall, side[4];
-    assert_ok(dem_material_create(d, &md, &mat));
-    dem_pair_def p = dem_default_pair_def();
-    p.restitution = 0.2;
-    p.friction = 0.3;
-    assert_ok(dem_pair_set(d, mat, mat, &p));
+    dem_domain *d = column_domain(&mat);
     dem_plane_wall_def w = dem_default_plane_wall_def(); /* floor z >= 0 */
     w.material = mat;
     assert_ok(dem_plane_wall_add(d, &w, &floor_wall));
