@@ -1,0 +1,53 @@
+"""Seed 001's pipeline on the shipped frame subset (data/seed001/frames_subset.h5: every case of
+Table 1, every 20th frame of the full set; docs/seed001.md): the stored labels are consistent
+with the physics of a discharge, the GRA weights are percentages, and the two cheap experiments
+and the report run end to end (tiny settings: this checks the chain, not the networks' skill)."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SUBSET = ROOT / "data/seed001/frames_subset.h5"
+
+
+def test_the_subset_holds_every_case_with_consistent_labels():
+    from pydem.frames import FrameStore
+    from pydem.rigs.hopper import TABLE1
+    store = FrameStore(SUBSET)
+    assert store.cases() == sorted(TABLE1)
+    for case in store.cases():
+        d = store.read_case(case)
+        assert d["frames"].dtype == np.uint8 and d["frames"].shape[1:] == (224, 224) and len(d["frames"]) >= 5
+        assert np.allclose(d["remaining_time"], d["discharge_time"] - d["time"])
+        assert np.all(np.diff(d["time"]) > 0) and np.all(np.diff(d["nrrp"]) <= 0)  # time-ordered, emptying
+        assert 0.0 <= d["nrrp"].min() and d["nrrp"].max() <= 1.0
+
+
+def test_gra_weights_are_percentages_over_the_cases():
+    from pydem.frames import FrameStore
+    from nn.seed001 import PARAMETERS, gra_tables
+    store = FrameStore(SUBSET)
+    tables = gra_tables({c: float(store.read_case(c)["discharge_time"]) for c in store.cases()})
+    assert set(tables) == {"A", "B1", "B2", "B3", "B4", "all"}
+    for t in tables.values():
+        assert set(t) == set(PARAMETERS) and sum(t.values()) == pytest.approx(100.0)
+
+
+def test_experiments_and_report_run_on_the_subset(tmp_path):
+    import torch
+    from nn import seed001_experiments as ex
+    from nn.seed001_report import write
+    torch.set_num_threads(1)
+    p2p = ex.point_to_point(SUBSET, tmp_path, size=64, every=2, epochs=1, say=lambda *a: None)
+    assert set(p2p["splits"]) == {"random_frames", "leave_cases_out"}
+    assert p2p["settings"]["test_cases"] == ["A-5", "B1-5", "B2-5", "B3-5", "B4-5"]
+    lco = p2p["splits"]["leave_cases_out"]
+    assert set(lco["test"]["case"]) == set(p2p["settings"]["test_cases"])  # whole cases held out
+    proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, say=lambda *a: None)
+    assert set(proc["per_packing"]) == {"A", "B1", "B2", "B3", "B4"}
+    page = write(SUBSET, tmp_path, tmp_path / "report")
+    text = page.read_text()
+    assert "Grey relational analysis" in text and "AlexNet-FC point to point" in text and "data:image/png;base64," in text
+    assert json.loads((tmp_path / "process.json").read_text())["settings"]["window"] == 2
