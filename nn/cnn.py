@@ -81,6 +81,15 @@ class VGG(nn.Module):
         self.head = nn.Sequential(
             nn.Linear(512 * 7 * 7, 4096), nn.ReLU(inplace=True), nn.Dropout(dropout),
             nn.Linear(4096, 4096), nn.ReLU(inplace=True), nn.Dropout(dropout), nn.Linear(4096, outputs))
+        # torchvision's initialisation: with torch's default (Kaiming-uniform, a = sqrt 5) the
+        # signal fades through 16-19 ReLU layers and training stalls at the mean
+        for m in self.modules():
+            if isinstance(m, nn.Conv2d):
+                nn.init.kaiming_normal_(m.weight, mode="fan_out", nonlinearity="relu")
+                nn.init.zeros_(m.bias)
+            elif isinstance(m, nn.Linear):
+                nn.init.normal_(m.weight, 0.0, 0.01)
+                nn.init.zeros_(m.bias)
 
     def forward(self, x):
         return self.head(torch.flatten(self.pool(self.features(x)), 1))
@@ -120,6 +129,12 @@ class ResNet50(nn.Module):
         self.stages = nn.Sequential(*stages)
         self.pool = nn.AdaptiveAvgPool2d((1, 1))
         self.head = nn.Linear(c, outputs)
+        for m in self.modules():  # torchvision's initialisation
+            if isinstance(m, nn.Conv2d):
+                nn.init.kaiming_normal_(m.weight, mode="fan_out", nonlinearity="relu")
+            elif isinstance(m, nn.BatchNorm2d):
+                nn.init.ones_(m.weight)
+                nn.init.zeros_(m.bias)
 
     def forward(self, x):
         return self.head(torch.flatten(self.pool(self.stages(self.stem(x))), 1))

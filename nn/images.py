@@ -119,8 +119,12 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
     opt = torch.optim.Adam(model.parameters(), lr=lr)
     state = {"epoch": 0, "history": [], "best": math.inf, "best_weights": None}
     ck = Path(checkpoint) if checkpoint else None
+    signature = {"model": type(model).__name__, "parameters": sum(p.numel() for p in model.parameters()),
+                 "x": list(np.shape(x)), "x_val": list(np.shape(x_val)), "batch": batch, "lr": lr, "seed": seed}
     if ck is not None and ck.exists():
         saved = torch.load(ck, weights_only=False)
+        if saved.get("signature") != signature:
+            raise ValueError(f"{ck}: a checkpoint of another training ({saved.get('signature')}); remove it to start afresh")
         model.load_state_dict(saved["model"])
         opt.load_state_dict(saved["optimizer"])
         state = saved["state"]
@@ -148,7 +152,7 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
             ck.parent.mkdir(parents=True, exist_ok=True)
             tmp = ck.with_suffix(".tmp")
             torch.save({"model": model.state_dict(), "optimizer": opt.state_dict(), "state": state,
-                        "rng": torch.get_rng_state()}, tmp)
+                        "rng": torch.get_rng_state(), "signature": signature}, tmp)
             tmp.replace(ck)
         if progress is not None:
             rate = seen / max(time.perf_counter() - t0, 1e-9)

@@ -67,6 +67,8 @@ def test_training_lowers_the_loss_and_resumes_bitwise(tmp_path):
     images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=3, batch=16, lr=3e-4, seed=2, checkpoint=ck)
     resumed = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2, checkpoint=ck)
     assert resumed["history"] == h
+    with pytest.raises(ValueError, match="another training"):  # other settings: refused, not resumed
+        images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=1e-3, seed=2, checkpoint=ck)
 
 
 def test_scores_by_hand():
