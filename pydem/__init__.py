@@ -5,6 +5,15 @@
 """
 __version__ = "0.2.0"
 
+import os as _os
+
+# OpenMP threads sleep at once at a barrier instead of spinning first: beside other processes a
+# 2-thread run then keeps the 1-thread speed (1.03x instead of 0.45x), at ~10 % on a quiet
+# machine (bench/README.md, "A busy machine"). Set before libdem loads libgomp; an explicit
+# OMP_WAIT_POLICY or GOMP_SPINCOUNT of the user wins.
+if "OMP_WAIT_POLICY" not in _os.environ and "GOMP_SPINCOUNT" not in _os.environ:
+    _os.environ["OMP_WAIT_POLICY"] = "passive"
+
 try:
     from ._libdem import ffi as _ffi, lib as _lib
 except ImportError as exc:  # the compiled binding is built by `make pydem`

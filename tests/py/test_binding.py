@@ -245,3 +245,18 @@ def test_shear_modulus_apart_from_e_and_nu_sets_the_tangential_stiffness():
     assert stiff == pytest.approx(expected3, rel=1e-2) and stiff / measured == pytest.approx(np.sqrt(3), rel=1e-2)
     with pytest.raises(pydem.DemInvalidArgument, match="shear modulus"):
         pydem.Domain().add_material(shear_modulus=-1.0)
+
+
+def test_openmp_threads_wait_passively_unless_the_user_chose():
+    """pydem asks libgomp for passive waiting before libdem loads it (a 2-thread run beside other
+    processes keeps the 1-thread speed, bench/README.md); a user's own choice wins."""
+    import os
+    import subprocess
+    import sys
+    code = "import os, pydem; print(os.environ.get('OMP_WAIT_POLICY'))"
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
+    run = lambda extra: subprocess.run([sys.executable, "-c", code], env=env | extra, capture_output=True,  # noqa: E731
+                                       text=True, check=True).stdout.strip()
+    assert run({}) == "passive"
+    assert run({"OMP_WAIT_POLICY": "active"}) == "active"
+    assert run({"GOMP_SPINCOUNT": "10000"}) == "None"
