@@ -10,6 +10,7 @@ from typing import Callable
 import numpy as np
 
 from ..domain import Domain
+from .checkpoint import CheckpointStop
 from .config import Params
 
 Progress = Callable[[float, float, dict], None]  # (simulated time, planned time, info)
@@ -160,7 +161,6 @@ class Stepper:
         return False
 
     def _save(self, done: int, total: int, n_chunk: int):
-        from .checkpoint import CheckpointStop
         ck, rig_state = self.ck
         ck.save(self.d, dict(rig_state(), stepper=dict(self.state(), advance=[done, total, n_chunk])))
         if ck.stopping(self.d.time):

@@ -24,7 +24,7 @@ from .. import geometry
 from ..domain import Domain
 from ..walls import MeshWall
 from .checkpoint import Checkpoint, CheckpointStop, signature
-from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, stable_dt, translational_energy_per_particle
+from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, stable_dt
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult
 
@@ -328,9 +328,6 @@ class Hopper:
         lattice of the coarse spacing, in the given bottom-to-top order, then settles a little.
         s["placed"] counts the spheres poured; s["batch_pending"]: the last batch is still
         settling (a checkpoint inside its settling resumes there)."""
-        c = self.config
-        dl = c.largest
-        spacing = 1.05 * dl
         while s["placed"] < len(order) or s["batch_pending"]:
             if not s["batch_pending"]:
                 self._pour_batch(d, rng, order, diameters, mf, mp, h_wedge, z_top, s)
