@@ -86,7 +86,7 @@ def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, th
     pts = design_points("sobol", ranges, 0, samples, seed)
     t0 = time.perf_counter()
     keep = np.ones(len(pts), bool)
-    misfit = np.zeros(len(pts))
+    resid = np.empty((len(model.y), len(pts)))
     natives = {}
     for k, net in enumerate(model.nets):
         if id(net) not in natives:  # a net that cannot be exported (a test's closed form) runs in numpy
@@ -94,8 +94,9 @@ def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, th
                                 else lambda x, _threads, net=net: net(x))
         pred = natives[id(net)](model.row_inputs(k, pts), threads)
         keep &= np.abs(pred - model.y[k]) <= window * abs(model.y[k])
-        misfit += ((pred - model.y[k]) / model.sigma[k]) ** 2
+        resid[k] = model.y[k] - pred
     seconds = time.perf_counter() - t0
+    misfit = np.sum(model.white(resid) ** 2, axis=0)  # chi^2 with the rows' covariance (fit.Model)
     idx = np.flatnonzero(keep)
     pool = idx if len(idx) else np.arange(len(pts))
     best = pts[pool[int(np.argmin(misfit[pool]))]]

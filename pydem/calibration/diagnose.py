@@ -109,27 +109,24 @@ class Diagnosis:
 
 
 def _score(model: Model, fit: Fit, parameter: str) -> tuple[float, float, np.ndarray]:
-    """(S, implied step, J_E) of the score test for one net input at the base fit."""
-    w = 1.0 / model.sigma ** 2
-    r = model.y - model.predict(fit.best)
-    jt = model.jacobian(fit.best)
-    je = model.net_jacobian(fit.best, parameter)
-    wj = jt * w[:, None]
-    a = jt.T @ wj + 1e-12 * np.eye(jt.shape[1])
-    mje = w * je - wj @ np.linalg.solve(a, wj.T @ je)
-    info = float(je @ mje)
+    """(S, implied step, M J_E) of the score test for one net input at the base fit, in whitened
+    units: M projects out what the base parameters can re-adjust."""
+    r = model.white(model.y - model.predict(fit.best))
+    jt = model.white(model.jacobian(fit.best))
+    je = model.white(model.net_jacobian(fit.best, parameter))
+    a = jt.T @ jt + 1e-12 * np.eye(jt.shape[1])
+    mje = je - jt @ np.linalg.solve(a, jt.T @ je)
+    info = float(mje @ mje)
     u = float(mje @ r)  # J_E' M r: the score with the base parameters re-adjusted
     if info <= 0:
         return 0.0, 0.0, mje
     return u * u / info, u / info, mje
 
 
-def _cosine(a: np.ndarray, b: np.ndarray, model: Model) -> float:
-    """Cosine between projected signatures in the metric W^-1 (a, b are M J)."""
-    s2 = model.sigma ** 2
-    num = float(a @ (s2 * b))
-    den = float(np.sqrt((a @ (s2 * a)) * (b @ (s2 * b))))
-    return abs(num) / den if den > 0 else 0.0
+def _cosine(a: np.ndarray, b: np.ndarray) -> float:
+    """Cosine between two candidates' projected, whitened signatures (M J_E)."""
+    den = float(np.linalg.norm(a) * np.linalg.norm(b))
+    return abs(float(a @ b)) / den if den > 0 else 0.0
 
 
 def _condition_key(o: Observation) -> str:
@@ -236,7 +233,7 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     similarity = {}
     for i, a in enumerate(results):
         for b in results[i + 1:]:
-            similarity[f"{a.effect}|{b.effect}"] = _cosine(mjs[a.effect], mjs[b.effect], base_model)
+            similarity[f"{a.effect}|{b.effect}"] = _cosine(mjs[a.effect], mjs[b.effect])
     sig = [r for r in results if r.p_value < ALPHA]
     after = after_model = None
     separating = {}

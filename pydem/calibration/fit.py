@@ -1,7 +1,17 @@
-"""Fitting the surrogates to observations: the model y_k = f_q(theta, eta, x_k) + noise with
-variance max(u_k, s_q)^2 + e_q^2 (u_k the row's stated uncertainty, s_q the rig's seed-to-seed
-scatter, e_q the net's own error: QuantityNet.row_sigma), chi^2 minimisation in the campaign box, and the
-posterior for a uniform prior on that box by importance sampling.
+"""Fitting the surrogates to observations: the model y_k = f_q(theta, eta, x_k) + noise, chi^2
+minimisation in the campaign box, and the posterior for a uniform prior on that box by
+importance sampling.
+
+The noise of row k has two parts. max(u_k, s_q) (u_k the row's stated uncertainty, s_q the rig's
+seed-to-seed scatter) is independent from row to row. The net's own error e_q is not: a smooth
+net fitted to ~100 runs errs smoothly, so at one parameter point its errors at neighbouring
+conditions (pre-shear stresses, shear fractions, slot widths) are nearly the same number.
+Treated as independent, such an error reads as a coherent trend over the conditions that an
+effect can fit (a false alarm on a DEM null set did exactly that). So rows of one quantity share
+it with correlation exp(-d^2 / 2 l^2), d the distance of their conditions in the net's scaled
+inputs ([-1, 1] over the campaign range), l = NET_ERROR_LENGTH; chi^2 is taken in the
+whitened residuals L^-1 r (C = L L^T). `sigma` stays the marginal standard deviation of each row
+(QuantityNet.row_sigma), for tables and plots.
 
 `Model` maps a vector of free parameters (the base parameters, plus at most a candidate's) to
 the nets' inputs: a candidate that is not free sits at its neutral value, which may follow the
@@ -12,11 +22,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import linalg, optimize, stats
 from scipy.stats import qmc
 
 from .candidates import BASE_PARAMETERS, Candidate
 from .quantities import Observation
+
+# correlation length of a net's error over the conditions, in its scaled inputs (the range is 2):
+# a tanh MLP of <= 24 units trained on ~100 runs over 6-8 inputs does not resolve features finer
+# than about half an input's range
+NET_ERROR_LENGTH = 1.0
 
 
 class Model:
@@ -31,7 +46,30 @@ class Model:
         self.hi = np.array([ranges[n][1] for n in self.free])
         self.y = np.array([o.value for o in observations])
         self.sigma = np.array([n.row_sigma(o.uncertainty) for o, n in zip(observations, self.nets)])
+        self.cov = self._covariance()
+        self._chol = np.linalg.cholesky(self.cov)
         self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
+
+    def _covariance(self) -> np.ndarray:
+        """Rows' noise covariance: independent scatter plus the nets' errors, correlated over
+        the conditions within one quantity (module docstring)."""
+        e = np.array([getattr(n, "net_error", 0.0) for n in self.nets])
+        cov = np.diag(self.sigma ** 2 - e ** 2)
+        for i, (oi, ni) in enumerate(zip(self.obs, self.nets)):
+            for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):
+                if ni is nj:
+                    d2 = sum(((oi.conditions[c] - oj.conditions[c]) * 2.0 / _input_width(ni, c)) ** 2
+                             for c in oi.conditions if c in ni.input_names)
+                    cov[i, j] += e[i] * e[j] * np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+        return cov
+
+    def white(self, v: np.ndarray) -> np.ndarray:
+        """L^-1 v for v (n,) or (n, k): residuals or Jacobian columns in units of the noise."""
+        return linalg.solve_triangular(self._chol, v, lower=True)
+
+    def white_rows(self, r: np.ndarray) -> np.ndarray:
+        """Whitened residuals for r (m, n): one row per parameter point."""
+        return linalg.solve_triangular(self._chol, np.atleast_2d(r).T, lower=True).T
 
     def _inputs_of(self, o: Observation, net, p: np.ndarray) -> np.ndarray:
         theta = dict(zip(self.free, p))
@@ -84,11 +122,16 @@ class Model:
         return np.array(out)
 
     def residuals(self, p):
-        return (self.y - self.predict(p)) / self.sigma
+        return self.white(self.y - self.predict(p))
 
     def chi2(self, p) -> np.ndarray:
-        r = (self.y - self.predict(np.atleast_2d(p))) / self.sigma
+        r = self.white_rows(self.y - self.predict(np.atleast_2d(p)))
         return np.sum(r * r, axis=1)
+
+
+def _input_width(net, name: str) -> float:
+    j = net.input_names.index(name)
+    return float(net.hi[j] - net.lo[j]) or 1.0
 
 
 @dataclass
@@ -136,7 +179,7 @@ def minimise(model: Model, starts: int = 4096, keep: int = 6, seed: int = 0, sta
     width = model.hi - model.lo
     for i in order:
         res = optimize.least_squares(lambda u: model.residuals(model.lo + u * width), (pts[i] - model.lo) / width,
-                                     jac=lambda u: -model.jacobian(model.lo + u * width) * width / model.sigma[:, None],
+                                     jac=lambda u: -model.white(model.jacobian(model.lo + u * width)) * width,
                                      bounds=(0.0, 1.0), method="trf", x_scale=1.0, max_nfev=200)
         p = model.lo + res.x * width
         c = float(model.chi2(p)[0])
@@ -155,7 +198,7 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     rng = np.random.default_rng(seed)
     lo, hi = fit.lo, fit.hi
     width = hi - lo
-    J = model.jacobian(fit.best) / model.sigma[:, None]
+    J = model.white(model.jacobian(fit.best))
     info = J.T @ J + np.diag(1e-9 / width ** 2)
     cov = 4.0 * np.linalg.inv(info)
     half = samples // 2

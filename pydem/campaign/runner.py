@@ -67,6 +67,28 @@ class Progress:
             self.stream.write("\n")
 
 
+def resolved_config(spec) -> dict:
+    """Every knob of the rig as this code resolves the spec's preset and fixed settings (at the
+    centre of the ranges; the varied keys and the thread count left out), so a store says what
+    "preset default" meant when it was run."""
+    from ..rigs.config import describe
+    centre = {k: 0.5 * (lo + hi) for k, (lo, hi) in spec.ranges.items()}
+    return {key: (value if isinstance(value, (int, float, str, bool)) else str(value))
+            for key, value, _, _ in describe(spec.config(centre)) if key not in spec.ranges
+            and key.split(".")[-1] not in spec.ranges}
+
+
+def config_drift(store) -> dict[str, tuple]:
+    """{knob: (value when the store was run, value now)} for every knob whose resolution of the
+    store's preset has changed since (the thread count is not the rig). Knobs added after the
+    store was run are left out: a new knob's default keeps the rig as it was."""
+    then = store.provenance.get("rig_config")
+    if not then:
+        return {}
+    now = resolved_config(store.spec)
+    return {k: (then[k], now.get(k)) for k in sorted(then) if k != "num_threads" and then[k] != now.get(k)}
+
+
 class Campaign:
     def __init__(self, store: CampaignStore):
         self.store = store
@@ -76,15 +98,9 @@ class Campaign:
         path = Path(path)
         if path.exists():
             raise StoreError(f"{path} exists already: run it again to continue, or choose another name")
-        from ..rigs.config import describe
         prov = provenance()
         prov["rig_protocol"] = RIGS[spec.rig][0].protocol
-        # every knob of the rig as this code resolves the preset (at the centre of the ranges), so
-        # the store says what "preset tiny" meant when it was run
-        centre = {k: 0.5 * (lo + hi) for k, (lo, hi) in spec.ranges.items()}
-        prov["rig_config"] = {key: (value if isinstance(value, (int, float, str, bool)) else str(value))
-                              for key, value, _, _ in describe(spec.config(centre)) if key not in spec.ranges
-                              and key.split(".")[-1] not in spec.ranges}
+        prov["rig_config"] = resolved_config(spec)
         store = CampaignStore(path, spec, prov)
         c = cls(store)
         c.grow(spec.samples, spec.replicates)
@@ -134,6 +150,12 @@ class Campaign:
                              f"with protocol {rig_cls.protocol} (see the rig's `protocol` note); adding runs would mix two "
                              f"definitions of the metrics in one data set. Start a new store, or continue it from commit "
                              f"{s.provenance.get('git_commit', 'unknown')}.")
+        drift = config_drift(s)
+        if drift:
+            raise StoreError(f"{s.path}: the {s.spec.preset!r} preset has changed since this store was run ("
+                             + "; ".join(f"{k}: {a} then, {b} now" for k, (a, b) in drift.items())
+                             + "): adding runs would mix two rigs in one data set. Start a new store, or continue it "
+                             f"from commit {s.provenance.get('git_commit', 'unknown')}.")
         from .. import LIBDEM_VERSION
         if s.physics != physics_of(LIBDEM_VERSION):
             raise StoreError(f"{s.path}: its runs were made with libdem {s.provenance.get('libdem', '0.1.0')}, this is "

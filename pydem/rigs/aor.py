@@ -36,9 +36,9 @@ class AorConfig:
     base_radius: float = knob(0.07, 1e-3, 5.0, "m", "radius of the base disk the heap forms on")
     base_friction: float = knob(0.9, 0.0, 2.0, "", "sliding friction sphere-base (a rough base)")
     base_rolling_friction: float = knob(0.3, 0.0, 1.0, "", "rolling friction sphere-base")
-    lift_speed: float = knob(0.05, 1e-4, 1.0, "m/s", "cylinder lifting speed")
+    lift_speed: float = knob(0.01, 1e-4, 1.0, "m/s", "cylinder lifting speed (slow: at 0.05 m/s the column collapses, docs/rigs.md)")
     rest_energy: float = knob(1e-5, 1e-9, 1.0, "", "at rest when translational kinetic energy per sphere < this x m g d")
-    max_time: float = knob(6.0, 0.05, 600.0, "s", "simulated time limit")
+    max_time: float = knob(10.0, 0.05, 600.0, "s", "simulated time limit")
     num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between PNG frames (with --frames)")
     params: Params = field(default_factory=Params)
@@ -47,7 +47,7 @@ class AorConfig:
     def preset(cls, name: str) -> "AorConfig":
         if name == "tiny":  # seconds: for tests
             return cls(particles=600, cylinder_radius=0.01, base_radius=0.035, lift_speed=0.1, max_time=3.0)
-        if name == "default":  # about a minute on 2 cores
+        if name == "default":  # about two minutes on one core (1.8 min at friction 0.5, rolling 0.3)
             return cls()
         if name == "paper":  # a lab-scale cylinder (50 mm) of 2 mm spheres
             return cls(particles=60000, diameter=2e-3, cylinder_radius=0.025, base_radius=0.1, lift_speed=0.01,
