@@ -55,9 +55,10 @@ def diagnose(args):
     for k, line in enumerate(Path(args.journal).read_text().splitlines()):
         row = json.loads(line)
         rng = np.random.default_rng(5000 + k)
-        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"])
-               for r in row["rows"] if r["value"] is not None]
-        vals = {i: r["value"] for i, r in enumerate(x for x in row["rows"] if x["value"] is not None)}
+        kept = [r for r in row["rows"] if r["value"] is not None and Quantity(r["rig"], r["metric"]) in setup.nets
+                and r["rig"] not in args.skip_rigs]  # rows of the given stores' rigs only
+        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
+        vals = {i: r["value"] for i, r in enumerate(kept)}
         noisy = synthetic.with_lab_noise(obs, vals, setup.nets, rng)
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
@@ -66,7 +67,7 @@ def diagnose(args):
                     "best": [(c.effect, round(c.statistic, 2), c.p_value) for c in d.candidates[:2]]})
         print(f"set {k}: {row['kind']:14s} truth {t['effect']}={t['strength']}  -> {d.verdict} {d.effect or ''}  "
               f"chi2/dof {d.base.chi2_per_dof:.2f}" + (f" -> {d.after.chi2_per_dof:.2f}" if d.after else ""), flush=True)
-    Path(args.journal).with_suffix(".diagnosed.json").write_text(json.dumps(out, indent=1, default=float))
+    Path(args.out or Path(args.journal).with_suffix(".diagnosed.json")).write_text(json.dumps(out, indent=1, default=float))
 
 
 def main() -> int:
@@ -80,6 +81,8 @@ def main() -> int:
     d = sub.add_parser("diagnose")
     d.add_argument("--journal", required=True)
     d.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
+    d.add_argument("--skip-rigs", nargs="*", default=[], help="leave these rigs' rows out (e.g. rows made at an older preset)")
+    d.add_argument("--out", help="verdicts file (default: the journal's name with .diagnosed.json)")
     args = ap.parse_args()
     run(args) if args.cmd == "run" else diagnose(args)
     return 0

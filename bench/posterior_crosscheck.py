@@ -4,10 +4,12 @@ DEM, https://github.com/GrainLearning/grainLearning) on the same surrogates and 
 pydem's posterior (pydem.calibration.fit.posterior): uniform prior on the campaign box,
 importance sampling from a Sobol/Gaussian mixture, our own chi^2. GrainLearning's: its SMC
 data-assimilation step (scipy multivariate normal likelihood, its own weighting and estimators)
-on a Halton sample of the prior, with its covariance sigma * W * obs^2 set so that it equals ours
-(W = diag((sigma_i / y_i)^2) normalised by its geometric mean g, sigma = g). Same posterior, two
-independent implementations: the means and standard deviations must agree within the sampling
-error.
+on a Halton sample of the prior. GrainLearning's covariance is diagonal (sigma * W * obs^2) while
+ours correlates a net's error over the conditions (fit.py), so both are given the whitened
+problem: observations and simulations mapped by L^-1 (C = L L^T, identity covariance), shifted by
+one constant so that GrainLearning's relative weights stay finite, and W = 1 / obs^2 normalised by
+its geometric mean g, sigma = g: the same likelihood. Same posterior, two independent
+implementations: the means and standard deviations must agree within the sampling error.
 
 GrainLearning needs numpy < 2, so it runs in a venv of its own:
     python3 -m venv /tmp/glvenv && /tmp/glvenv/bin/pip install "numpy<2" grainlearning cffi h5py scipy
@@ -30,13 +32,14 @@ def grainlearning_posterior(model, samples: int, seed: int):
     from grainlearning import DynamicSystem
     from grainlearning.inference import SMC
     from grainlearning.sampling import generate_params_qmc
-    y = model.y
-    w = (model.sigma / y) ** 2
+    shift = 10.0 + float(np.abs(model.white(model.y)).max())
+    y = model.white(model.y) + shift  # identity covariance in these units
+    w = 1.0 / y ** 2
     g = float(np.exp(np.mean(np.log(w))))
     system = DynamicSystem(obs_data=y[:, None], param_min=list(model.lo), param_max=list(model.hi), num_samples=samples,
                            param_names=list(model.free), ctrl_data=np.zeros(1), inv_obs_weight=list(w))
     system.param_data = generate_params_qmc(system, samples, method="halton", seed=seed)
-    system.set_sim_data(model.predict(system.param_data)[:, :, None])
+    system.set_sim_data((model.white_rows(model.predict(system.param_data)) + shift)[:, :, None])
     smc = SMC(ess_target=0.3, scale_cov_with_max=False)
     smc.data_assimilation_loop(sigma=g, system=system)
     system.compute_estimated_params(smc.posteriors)

@@ -9,7 +9,9 @@ conditions (pre-shear stresses, shear fractions, slot widths) are nearly the sam
 Treated as independent, such an error reads as a coherent trend over the conditions that an
 effect can fit (a false alarm on a DEM null set did exactly that). So rows of one quantity share
 it with correlation exp(-d^2 / 2 l^2), d the distance of their conditions in the net's scaled
-inputs ([-1, 1] over the campaign range), l = NET_ERROR_LENGTH; chi^2 is taken in the
+inputs ([-1, 1] over the campaign range), l = NET_ERROR_LENGTH. And the points of one test (the
+shear points of one pre-shear stress: one specimen) share their specimen's scatter: the rows'
+seed-scatter parts correlate with the net's measured `test_correlation`. chi^2 is taken in the
 whitened residuals L^-1 r (C = L L^T). `sigma` stays the marginal standard deviation of each row
 (QuantityNet.row_sigma), for tables and plots.
 
@@ -54,13 +56,17 @@ class Model:
         """Rows' noise covariance: independent scatter plus the nets' errors, correlated over
         the conditions within one quantity (module docstring)."""
         e = np.array([getattr(n, "net_error", 0.0) for n in self.nets])
+        s = np.array([getattr(n, "seed_sd", 0.0) for n in self.nets])
         cov = np.diag(self.sigma ** 2 - e ** 2)
         for i, (oi, ni) in enumerate(zip(self.obs, self.nets)):
             for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):
-                if ni is nj:
-                    d2 = sum(((oi.conditions[c] - oj.conditions[c]) * 2.0 / _input_width(ni, c)) ** 2
-                             for c in oi.conditions if c in ni.input_names)
-                    cov[i, j] += e[i] * e[j] * np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+                if ni is not nj:
+                    continue
+                d2 = sum(((oi.conditions[c] - oj.conditions[c]) * 2.0 / _input_width(ni, c)) ** 2
+                         for c in oi.conditions if c in ni.input_names)
+                cov[i, j] += e[i] * e[j] * np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+                if i != j and _same_test(oi, oj):
+                    cov[i, j] += getattr(ni, "test_correlation", 0.0) * s[i] * s[j]
         return cov
 
     def white(self, v: np.ndarray) -> np.ndarray:
@@ -127,6 +133,12 @@ class Model:
     def chi2(self, p) -> np.ndarray:
         r = self.white_rows(self.y - self.predict(np.atleast_2d(p)))
         return np.sum(r * r, axis=1)
+
+
+def _same_test(a: Observation, b: Observation) -> bool:
+    """Two points of one test: the same conditions but the shear fraction (one specimen)."""
+    return a.conditions.keys() == b.conditions.keys() and "shear_fraction" in a.conditions and all(
+        a.conditions[k] == b.conditions[k] for k in a.conditions if k != "shear_fraction")
 
 
 def _input_width(net, name: str) -> float:

@@ -9,7 +9,9 @@ is analytic).
 Each net's error model is its hold-out RMSE against single runs: the rig's seed-to-seed
 scatter and the net's own error together, which is what separates one DEM run (or one lab
 repeat) from the surrogate's smooth mean; the diagnosis adds it to every row's measurement
-uncertainty."""
+uncertainty. A quantity measured at several points of one test (the shear points of one
+ring-shear run) also carries how much those points' errors go together: one specimen, one
+packing (`test_correlation`, measured on the store's runs)."""
 from __future__ import annotations
 
 import hashlib
@@ -44,6 +46,7 @@ class QuantityNet:
     runs: int
     unit: str = ""
     scatter: float = float("nan")  # seed-to-seed sd of one run, from replicate runs (nan: unknown)
+    test_correlation: float = 0.0  # correlation of one run's errors at its several points (shear points)
 
     @property
     def seed_sd(self) -> float:
@@ -94,14 +97,15 @@ class QuantityNet:
                 "meta": np.array(json.dumps({"rig": self.quantity.rig, "metric": self.quantity.metric,
                                              "inputs": self.input_names, "y_lo": self.y_lo, "y_hi": self.y_hi,
                                              "b2": self.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
-                                             "unit": self.unit, "scatter": self.scatter, "format": NET_FORMAT}))}
+                                             "unit": self.unit, "scatter": self.scatter,
+                                             "test_correlation": self.test_correlation, "format": NET_FORMAT}))}
 
     @classmethod
     def from_arrays(cls, a) -> "QuantityNet":
         meta = json.loads(str(a["meta"]))
         return cls(Quantity(meta["rig"], meta["metric"]), meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
                    a["w1"], a["b1"], a["w2"], meta["b2"], meta["rmse"], meta["r2"], meta["runs"], meta["unit"],
-                   meta.get("scatter", float("nan")))
+                   meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0))
 
 
 def replicate_store_path(store) -> Path:
@@ -126,6 +130,27 @@ def seed_scatter(store) -> dict[Quantity, float]:
         if dof > 0:
             out[Quantity(rig, metric)] = float(np.sqrt(ss / dof))
     return out
+
+
+def test_correlation(store, net: QuantityNet) -> float:
+    """How much one run's errors at its several points (the shear fractions of one ring-shear
+    run) go together: the mean correlation between the net's residuals at two points of the
+    same run, over the store's finished runs (in-sample residuals: seed scatter and the net's
+    misfit, which is what a measurement of the same test shares); clipped to [0, 0.95]; 0 for a
+    quantity measured once per run."""
+    names = [m for m in store.metric_names if m.startswith(net.quantity.metric + "_")]
+    if "shear_fraction" not in net.input_names or len(names) < 2:
+        return 0.0
+    cols = []
+    for m in names:
+        frac = int(m.rsplit("_", 1)[1]) / 100.0
+        x = np.column_stack([store.params, np.full(len(store.params), frac)])
+        cols.append(store.values[:, store.metric_names.index(m)] - net(x))
+    r = np.array(cols).T[(store.status == 1) & np.all(np.isfinite(np.array(cols).T), axis=1)]
+    if len(r) < 10:
+        return 0.0
+    c = np.corrcoef(r.T)
+    return float(np.clip(c[np.triu_indices(len(names), 1)].mean(), 0.0, 0.95))
 
 
 def store_hash(store) -> str:
@@ -179,6 +204,8 @@ def load_or_train(store, say=print, retrain: bool = False) -> dict[Quantity, Qua
         for f in sorted(d.glob("*.npz")):
             with np.load(f) as a:
                 n = QuantityNet.from_arrays(a)
+                if "test_correlation" not in str(a["meta"]):  # cached before it was measured
+                    n.test_correlation = test_correlation(store, n)
             nets[n.quantity] = n
         return nets
     say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs; cached in {d})")
@@ -190,6 +217,10 @@ def load_or_train(store, say=print, retrain: bool = False) -> dict[Quantity, Qua
             if q in nets:
                 nets[q].scatter = sd
                 say(f"  {q.key:28s} seed scatter {sd:.4g} (from {rep.name})")
+    for q, n in nets.items():
+        n.test_correlation = test_correlation(store, n)
+        if n.test_correlation:
+            say(f"  {q.key:28s} errors of one run's points correlated {n.test_correlation:.2f}")
     d.mkdir(exist_ok=True)
     for old in d.glob("*.npz"):
         old.unlink()

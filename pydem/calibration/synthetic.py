@@ -125,8 +125,25 @@ def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np
                   obs: list[Observation]) -> list[Observation]:
     """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
     values = surrogate_values(nets, candidates, truth, obs)
-    values = {i: v + rng.normal(0.0, nets[o.quantity].seed_sd) for (i, v), o in zip(values.items(), obs)}
-    return with_lab_noise(obs, values, nets, rng)
+    return with_lab_noise(obs, {i: values[i] + d for i, d in enumerate(seed_scatter_draw(nets, obs, rng))}, nets, rng)
+
+
+def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generator) -> np.ndarray:
+    """One draw of the rigs' seed scatter over a programme, as DEM runs make it: one run per test,
+    so the points of one test (the shear points of one pre-shear stress) share a part of it
+    (the net's `test_correlation`), and different tests are independent."""
+    out = np.zeros(len(obs))
+    tests: dict = {}
+    for i, o in enumerate(obs):
+        key = (o.quantity, tuple((k, v) for k, v in o.conditions.items() if k != "shear_fraction"))
+        tests.setdefault(key, []).append(i)
+    for (q, _), rows in tests.items():
+        net = nets[q]
+        rho = getattr(net, "test_correlation", 0.0) if len(rows) > 1 else 0.0
+        shared = rng.normal()
+        for i in rows:
+            out[i] = net.seed_sd * (math.sqrt(rho) * shared + math.sqrt(1.0 - rho) * rng.normal())
+    return out
 
 
 def signal(setup, truth: Truth, obs: list[Observation]) -> float:

@@ -128,6 +128,12 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
     c.store.save()
     with pytest.raises(StoreError, match="protocol 0, this code measures with protocol 1"):
         Campaign.open(tmp_path / "s.h5").run(quiet=True)
+    # nor one whose preset has changed since it was run (the angle of repose's lift speed, say)
+    c.store.provenance["rig_protocol"] = 1
+    c.store.provenance["rig_config"]["lift_speed"] = 0.05
+    c.store.save()
+    with pytest.raises(StoreError, match="'tiny' preset has changed.*lift_speed: 0.05 then, 0.1 now"):
+        Campaign.open(tmp_path / "s.h5").run(quiet=True)
     (tmp_path / "junk.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     with pytest.raises(StoreError, match="unreadable campaign store"):
         CampaignStore.open(tmp_path / "junk.h5")

@@ -28,10 +28,10 @@ class LinearNet:
     the parameters (score = likelihood ratio exactly), with signatures that change with the
     condition (as cohesion's falls with the pre-shear stress). The QuantityNet interface."""
 
-    def __init__(self, q, a, b, c0, sigma=0.01):
+    def __init__(self, q, a, b, c0, sigma=0.01, net_error=0.0):
         self.quantity, self.a, self.b, self.c0 = q, np.asarray(a, float), np.asarray(b, float), c0
         self.input_names = INPUTS
-        self.rmse, self.scatter, self.net_error = sigma, float("nan"), sigma
+        self.rmse, self.scatter, self.net_error = math.hypot(sigma, net_error), sigma, net_error
         self.lo = np.array([RANGES[n][0] for n in INPUTS])
         self.hi = np.array([RANGES[n][1] for n in INPUTS])
 
@@ -46,7 +46,7 @@ class LinearNet:
         return np.column_stack([self.a + self.b * c, p @ self.b])
 
     def row_sigma(self, u):
-        return math.hypot(u, self.net_error)
+        return math.sqrt(u * u + self.scatter ** 2 + self.net_error ** 2)
 
 
 # three quantities over one condition c in [0.1, 0.9]; candidate a acts most at low c (like
@@ -54,10 +54,10 @@ class LinearNet:
 Q = [Quantity("ring-shear", "mu_ie_ps"), Quantity("ring-shear", "mu_ie_s"), Quantity("aor", "angle_of_repose")]
 
 
-def world(rng_cond=np.linspace(0.1, 0.9, 5)):
-    nets = {Q[0]: LinearNet(Q[0], [0.5, 0.2, 0.0, 0.5, 0.0], [0.0, 0.0, 0.0, -0.5, 0.1], 0.2),
-            Q[1]: LinearNet(Q[1], [0.6, 0.1, 0.02, 0.8, 0.0], [0.0, 0.05, 0.0, -0.8, 0.3], 0.1),
-            Q[2]: LinearNet(Q[2], [0.3, 0.6, 0.3, 0.1, 0.1], [0.0, 0.0, 0.0, 0.0, 0.4], 0.3)}
+def world(rng_cond=np.linspace(0.1, 0.9, 5), sigma=0.01, net_error=0.0):
+    nets = {Q[0]: LinearNet(Q[0], [0.5, 0.2, 0.0, 0.5, 0.0], [0.0, 0.0, 0.0, -0.5, 0.1], 0.2, sigma, net_error),
+            Q[1]: LinearNet(Q[1], [0.6, 0.1, 0.02, 0.8, 0.0], [0.0, 0.05, 0.0, -0.8, 0.3], 0.1, sigma, net_error),
+            Q[2]: LinearNet(Q[2], [0.3, 0.6, 0.3, 0.1, 0.1], [0.0, 0.0, 0.0, 0.0, 0.4], 0.3, sigma, net_error)}
     obs = [Observation(q, {"condition": float(c)}, math.nan, 0.01, f"{q.key} c={c:.2f}") for q in Q for c in rng_cond]
     return nets, obs
 
@@ -66,7 +66,7 @@ def generate(nets, obs, theta, eta, rng):
     out = []
     for o in obs:
         x = np.array([[theta[0], theta[1], theta[2], eta.get("eta_a", 0.0), eta.get("eta_b", 0.0), o.conditions["condition"]]])
-        sd = nets[o.quantity].row_sigma(o.uncertainty)
+        sd = math.sqrt(o.uncertainty ** 2 + nets[o.quantity].scatter ** 2)  # the net's error is the caller's
         out.append(Observation(o.quantity, o.conditions, float(nets[o.quantity](x)[0] + rng.normal(0, sd)), o.uncertainty, o.label))
     return out
 
@@ -94,7 +94,7 @@ def test_posterior_matches_the_laplace_closed_form():
     m = Model(data, nets, RANGES, CANDS)
     f = minimise(m)
     post = posterior(m, f)
-    J = m.jacobian(f.best) / m.sigma[:, None]
+    J = m.white(m.jacobian(f.best))
     sd = np.sqrt(np.diag(np.linalg.inv(J.T @ J)))
     for j, name in enumerate(f.names):
         assert post["parameters"][name]["sd"] == pytest.approx(sd[j], rel=0.05)
@@ -121,6 +121,71 @@ def test_verdicts_accuracy_and_false_alarms_in_a_linear_world():
         assert after["rmse_relative"] < before["rmse_relative"]
         c = d.candidates[0]  # the truth inside the effect's 95 % credible interval
         assert c.estimate_lo <= list(eta.values())[0] <= c.estimate_hi, (c.estimate_lo, c.estimate_hi)
+
+
+def test_chi2_is_the_quadratic_form_of_the_stated_covariance():
+    """chi^2 in whitened residuals equals r' C^-1 r with C written out by hand: independent
+    scatter on the diagonal plus each quantity's net error with correlation
+    exp(-d^2 / 2 l^2) over its conditions (d in the net's scaled inputs); rows of different
+    quantities uncorrelated. Exact up to round-off (1e-9 relative)."""
+    from pydem.calibration import fit
+    cond = np.array([0.1, 0.3, 0.9])
+    nets, obs = world(cond, sigma=0.01, net_error=0.02)
+    data = generate(nets, obs, (0.4, 0.5, 0.5), {}, np.random.default_rng(8))
+    m = Model(data, nets, RANGES, CANDS)
+    p = np.array([0.3, 0.6, 0.45])
+    r = m.y - m.predict(p)
+    n = len(data)
+    c = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            if data[i].quantity == data[j].quantity:
+                d = 2.0 * (data[i].conditions["condition"] - data[j].conditions["condition"])  # range [0, 1]
+                c[i, j] = 0.02 ** 2 * math.exp(-0.5 * d * d / fit.NET_ERROR_LENGTH ** 2)
+    c += np.diag([0.01 ** 2 + 0.01 ** 2] * n)  # stated u and the seed scatter
+    assert float(m.chi2(p)[0]) == pytest.approx(float(r @ np.linalg.solve(c, r)), rel=1e-9)
+    assert np.allclose(m.sigma, np.sqrt(np.diag(c)))
+
+
+def test_points_of_one_test_share_their_specimen_scatter():
+    """Shear points of one test (same pre-shear stress, one specimen) share the seed scatter with
+    the net's test_correlation; points of different tests do not; the net error's kernel adds to
+    both. The covariance written out by hand, exact up to round-off."""
+    from pydem.calibration import fit
+    net = LinearNet(Q[1], [0.6, 0.1, 0.02, 0.0, 0.0], [0.0] * 5, 0.1, sigma=0.02, net_error=0.01)
+    net.input_names = INPUTS[:5] + ["preshear_stress", "shear_fraction"]
+    net.lo, net.hi = np.append(net.lo[:5], [500.0, 0.3]), np.append(net.hi[:5], [10500.0, 0.9])
+    net.seed_sd, net.test_correlation = 0.02, 0.5
+    rows = [(1000.0, 0.4), (1000.0, 0.8), (5000.0, 0.4)]
+    obs = [Observation(Q[1], {"preshear_stress": p, "shear_fraction": f}, 0.5, 0.03, "r") for p, f in rows]
+    m = Model(obs, {Q[1]: net}, RANGES, CANDS)
+    c = np.zeros((3, 3))
+    for i, (pi, fi) in enumerate(rows):
+        for j, (pj, fj) in enumerate(rows):
+            d2 = (2 * (pi - pj) / 10000.0) ** 2 + (2 * (fi - fj) / 0.6) ** 2
+            c[i, j] = 0.01 ** 2 * math.exp(-0.5 * d2 / fit.NET_ERROR_LENGTH ** 2)
+            c[i, j] += (0.03 ** 2 + 0.02 ** 2) if i == j else (0.5 * 0.02 ** 2 if pi == pj else 0.0)
+    assert np.allclose(m.cov, c, rtol=1e-12, atol=0)
+
+
+def test_a_smooth_net_error_over_the_conditions_raises_no_alarm():
+    """Null sets whose surrogate errs smoothly over the conditions (a Gaussian-process draw per
+    quantity with the covariance fit.py assumes, the net error twice the independent noise): the
+    false alarms stay at the nominal level (two candidates at p < 0.01: ~2 %; at most 3 of 30
+    allowed, binomial tail ~ 3 % at a true 2.5 %)."""
+    from pydem.calibration import fit
+    cond = np.linspace(0.1, 0.9, 5)
+    nets, obs = world(cond, sigma=0.01, net_error=0.02)
+    d2 = ((cond[:, None] - cond[None, :]) * 2.0) ** 2  # the condition's input range is [0, 1]: width 1
+    k = 0.02 ** 2 * np.exp(-0.5 * d2 / fit.NET_ERROR_LENGTH ** 2) + 1e-12 * np.eye(len(cond))
+    rng = np.random.default_rng(7)
+    alarms = 0
+    for _ in range(30):
+        data = generate(nets, obs, rng.uniform(0.2, 0.8, 3), {}, rng)
+        smooth = np.concatenate([rng.multivariate_normal(np.zeros(len(cond)), k) for _ in Q])
+        data = [Observation(o.quantity, o.conditions, o.value + e, o.uncertainty, o.label) for o, e in zip(data, smooth)]
+        alarms += dg.diagnose("null", data, nets, RANGES, CANDS, say=lambda *a: None).verdict != "no_effect_needed"
+    assert alarms <= 3, alarms
 
 
 def test_one_sided_candidate_rejects_a_negative_effect():
