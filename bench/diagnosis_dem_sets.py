@@ -8,6 +8,7 @@ diagnosis on the given stores.
 
     .venv/bin/python bench/diagnosis_dem_sets.py run --kinds null cohesion_sjkr --journal bench/results/dem_sets_default.jsonl
     .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl
+    .venv/bin/python bench/diagnosis_dem_sets.py rerun --rig aor --journal bench/results/dem_sets_default.jsonl
 """
 from __future__ import annotations
 
@@ -38,7 +39,7 @@ def run(args):
         rng = np.random.default_rng(args.seed + k)
         truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, None if kind == "null" else kind)
         obs = synthetic.programme(setup.nets)
-        values = synthetic.rig_values(setup.stores, truth.inputs(setup.candidates), obs, seed=1000 + k, threads=1)
+        values = synthetic.rig_values(stores, truth.inputs(registry()), obs, seed=1000 + k, threads=1)
         row = {"kind": kind, "truth": {"theta": truth.theta, "effect": truth.effect, "parameter": truth.parameter,
                                         "strength": truth.strength},
                "rows": [{"rig": o.quantity.rig, "metric": o.quantity.metric, "conditions": o.conditions,
@@ -46,6 +47,36 @@ def run(args):
         with open(journal, "a") as f:
             f.write(json.dumps(row) + "\n")
         print(f"set {k} ({kind}) done: {sum(r['value'] is not None for r in row['rows'])} of {len(obs)} rows", flush=True)
+
+
+def rerun(args):
+    """Runs one rig's rows of every set again at the rig's current preset (after a preset change:
+    the angle of repose's slow lift), same truths and seeds; the other rows are kept. The journal
+    is rewritten whole after each set (resumable: a set already rerun at this preset is skipped)."""
+    from pydem.calibration.candidates import registry
+    from pydem.campaign.runner import Campaign, resolved_config
+    stores = {st.spec.rig: st for st in (Campaign.open(p).store for p in args.stores)}
+    journal = Path(args.journal)
+    lines = [json.loads(x) for x in journal.read_text().splitlines()]
+    for k, row in enumerate(lines):
+        rig = args.rig
+        stamp = resolved_config(stores[rig].spec)
+        if row.get("rerun", {}).get(rig) == stamp:
+            continue
+        t = row["truth"]
+        truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
+        idx = [i for i, r in enumerate(row["rows"]) if r["rig"] == rig]
+        obs = [Observation(Quantity(rig, row["rows"][i]["metric"]), row["rows"][i]["conditions"], math.nan, math.nan,
+                           row["rows"][i]["label"]) for i in idx]
+        values = synthetic.rig_values(stores, truth.inputs(registry()), obs, seed=1000 + k, threads=1)
+        for j, i in enumerate(idx):
+            row["rows"][i]["value"] = values.get(j)
+        row.setdefault("rerun", {})[rig] = stamp
+        tmp = journal.with_suffix(".tmp")
+        tmp.write_text("".join(json.dumps(x) + "\n" for x in lines))
+        tmp.replace(journal)
+        print(f"set {k} ({row['kind']}): {rig} rows rerun: " + ", ".join(f"{obs[j].quantity.metric} {values.get(j)}"
+                                                                         for j in range(len(obs))), flush=True)
 
 
 def diagnose(args):
@@ -83,8 +114,12 @@ def main() -> int:
     d.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
     d.add_argument("--skip-rigs", nargs="*", default=[], help="leave these rigs' rows out (e.g. rows made at an older preset)")
     d.add_argument("--out", help="verdicts file (default: the journal's name with .diagnosed.json)")
+    e = sub.add_parser("rerun", help="run one rig's rows again at its current preset")
+    e.add_argument("--journal", required=True)
+    e.add_argument("--rig", required=True)
+    e.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
     args = ap.parse_args()
-    run(args) if args.cmd == "run" else diagnose(args)
+    {"run": run, "diagnose": diagnose, "rerun": rerun}[args.cmd](args)
     return 0
 
 

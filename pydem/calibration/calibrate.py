@@ -60,6 +60,21 @@ def residual_table(observations: list[Observation], model: Model, fit: Fit) -> l
     return rows
 
 
+def row_notes(observations: list[Observation]) -> list[str]:
+    """Notes on what the rows do not say or say beyond the surrogates: no uncertainty given, and
+    conditions that no surrogate takes (compared at the campaign preset's value)."""
+    notes = []
+    unstated = [o.label for o in observations if not o.uncertainty_given]
+    if unstated:
+        notes.append("no uncertainty given for " + ", ".join(unstated) + ": the rig's seed-to-seed scatter stands in "
+                     "for the lab's repeat scatter (the likelihood's floor in any case)")
+    for o in observations:
+        if o.ignored:
+            notes.append(f"{o.label}: condition(s) " + ", ".join(f"{k}={v}" for k, v in o.ignored.items())
+                         + " not taken by the surrogate: compared with the campaign preset as it is")
+    return notes
+
+
 def fit_summary(model: Model, fit: Fit) -> dict:
     rel = (model.y - model.predict(fit.best)) / model.y
     return {"chi2": fit.chi2, "chi2_per_dof": fit.chi2_per_dof, "dof": fit.dof, "p_value": fit.p_value,
@@ -134,6 +149,7 @@ def calibrate(material: str, observations: list[Observation], nets: dict, ranges
                          f"box may be too small, or the model misses an effect (`pydem diagnose`)")
     if covered:
         notes.append("held at their neutral values: " + ", ".join(f"{c.name} ({c.parameter})" for c in covered))
+    notes += row_notes(observations)
     for o in observations:
         if o.assumed:
             notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))

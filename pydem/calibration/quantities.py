@@ -50,6 +50,10 @@ class Observation:
     uncertainty: float            # the measurement's own standard uncertainty
     label: str
     assumed: dict[str, float] = field(default_factory=dict)  # conditions the file did not give
+    # False: the file gives no uncertainty; the likelihood's floor, the rig's seed-to-seed scatter
+    # (fit.Model: max(u, scatter)), is then the row's whole measurement uncertainty
+    uncertainty_given: bool = True
+    ignored: dict[str, str] = field(default_factory=dict)  # the file's conditions no surrogate takes (reported)
 
     def condition_text(self) -> str:
         return ", ".join(f"{k}={v:g}" + (" (assumed)" if k in self.assumed else "") for k, v in self.conditions.items())
@@ -88,9 +92,10 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
         except ValueError:
             raise ObservationError(f"line {m.line}: {m.label}: condition {name}={text!r} is not a number "
                                    f"(in {CONDITION_UNITS[name] or 'a fraction'})") from None
-    if not math.isfinite(m.uncertainty):
-        raise ObservationError(f"line {m.line}: {m.label}: no uncertainty given; the likelihood needs one")
-    return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed)
+    ignored = {k: v for k, v in m.conditions.items() if k not in q.conditions}
+    if not math.isfinite(m.uncertainty):  # not published (the JKU angles): the rig's seed scatter stands in
+        return Observation(q, cond, float(m.value), 0.0, m.label, assumed, uncertainty_given=False, ignored=ignored)
+    return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed, ignored=ignored)
 
 
 def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
