@@ -91,9 +91,9 @@ def write_subset(full: str, out: str, every: int):
                        attrs | {"subset_every": every})
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str = "python -m nn.seed001") -> int:
     from pydem.rigs.hopper import TABLE1
-    ap = argparse.ArgumentParser(prog="python -m nn.seed001")
+    ap = argparse.ArgumentParser(prog=prog)
     sub = ap.add_subparsers(dest="cmd", required=True)
     f = sub.add_parser("frames", help="run the Table 1 cases into the frame store (resumable)")
     f.add_argument("--store", required=True)
@@ -109,7 +109,7 @@ def main(argv=None) -> int:
     sb.add_argument("--every", type=int, default=25)
     for name, what in (("compare", "AlexNet, ResNet-50, VGG-16, VGG-19 on the remaining discharge time"),
                        ("point-to-point", "AlexNet-FC, random-frame and leave-cases-out splits"),
-                       ("process", "the CNN-LSTM per case on NRRP(t) from its first 20 %")):
+                       ("process", "the CNN-LSTM per case on NRRP(t) from its first 20 %%")):
         e = sub.add_parser(name, help=what)
         e.add_argument("--store", required=True)
         e.add_argument("--out", required=True, help="directory for the results JSON and the training checkpoints")

@@ -57,16 +57,21 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--checkpoint-every", type=float, default=600.0, help="seconds of wall time between checkpoints")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
-    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_locus
+    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_images, cli_locus
     cli_campaign.add_parser(sub)
     cli_compare.add_parser(sub)
     cli_diagnose.add_parser(sub)
     cli_calibrate.add_parser(sub)
     cli_locus.add_parser(sub)
+    cli_images.add_parser(sub)
     return ap
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["images"]:
+        from .cli_images import forward
+        return forward(argv[1:])
     args = build_parser().parse_args(argv)
     if hasattr(args, "func"):
         return args.func(args)

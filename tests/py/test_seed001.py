@@ -35,6 +35,18 @@ def test_gra_weights_are_percentages_over_the_cases():
         assert set(t) == set(PARAMETERS) and sum(t.values()) == pytest.approx(100.0)
 
 
+def test_pydem_images_is_the_seed001_command_line():
+    """`pydem images ...` hands its arguments to nn.seed001 whole (its own --help included)."""
+    import subprocess
+    import sys
+    run = lambda *a: subprocess.run([sys.executable, "-m", "pydem", "images", *a], capture_output=True, text=True,
+                                    timeout=120)
+    r = run("--help")
+    assert r.returncode == 0 and "usage: pydem images" in r.stdout and "point-to-point" in r.stdout
+    r = run("gra", "--store", str(SUBSET))
+    assert r.returncode == 0 and r.stdout.startswith("| parameter | A | B1 |"), r.stderr
+
+
 def test_experiments_and_report_run_on_the_subset(tmp_path):
     import torch
     from nn import seed001_experiments as ex
