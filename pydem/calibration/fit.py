@@ -49,7 +49,8 @@ class Model:
         self.y = np.array([o.value for o in observations])
         self.sigma = np.array([n.row_sigma(o.uncertainty) for o, n in zip(observations, self.nets)])
         self.cov = self._covariance()
-        self._chol = np.linalg.cholesky(self.cov)
+        # L^-1 once (rows are tens): whitening is then a small matrix product, not a solve per call
+        self._whiten = linalg.solve_triangular(np.linalg.cholesky(self.cov), np.eye(len(self.y)), lower=True)
         self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
 
     def _covariance(self) -> np.ndarray:
@@ -71,11 +72,11 @@ class Model:
 
     def white(self, v: np.ndarray) -> np.ndarray:
         """L^-1 v for v (n,) or (n, k): residuals or Jacobian columns in units of the noise."""
-        return linalg.solve_triangular(self._chol, v, lower=True)
+        return self._whiten @ v
 
     def white_rows(self, r: np.ndarray) -> np.ndarray:
         """Whitened residuals for r (m, n): one row per parameter point."""
-        return linalg.solve_triangular(self._chol, np.atleast_2d(r).T, lower=True).T
+        return np.atleast_2d(r) @ self._whiten.T
 
     def _inputs_of(self, o: Observation, net, p: np.ndarray) -> np.ndarray:
         theta = dict(zip(self.free, p))
