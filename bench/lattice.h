@@ -11,13 +11,14 @@
 #define LATTICE_RADIUS 1e-3
 
 /* Fills malloc'ed arrays (caller frees); returns the sphere count. */
-static int64_t lattice(int n_side, int nz, int material, double **pos, double **vel, double **rad, int **mats)
+static int64_t lattice(int n_side, int nz, dem_material material, double **pos, double **vel, double **rad,
+                       dem_material **mats)
 {
     const int64_t n = (int64_t)n_side * n_side * nz;
     *pos = malloc(sizeof(double) * 3 * n);
     *vel = malloc(sizeof(double) * 3 * n);
     *rad = malloc(sizeof(double) * n);
-    *mats = malloc(sizeof(int) * n);
+    *mats = malloc(sizeof(dem_material) * n);
     uint64_t rng = 42;
     for (int64_t k = 0; k < n; k++) {
         int64_t c[3] = {k % n_side, (k / n_side) % n_side, k / ((int64_t)n_side * n_side)};

@@ -74,7 +74,7 @@ static dem_domain *build(int variant, int *n_triangles)
         fprintf(stderr, "mesh_walls: %s\n", msg);
         exit(1);
     }
-    int mat;
+    dem_material mat;
     dem_material_def m = dem_default_material_def();
     check(d, dem_material_create(d, &m, &mat), "material");
     dem_pair_def p = dem_default_pair_def();
@@ -89,7 +89,7 @@ static dem_domain *build(int variant, int *n_triangles)
             w.side = faces[k][1];
             w.position = w.side > 0 ? 0.0 : def.hi[w.axis];
             w.material = mat;
-            int id;
+            dem_plane_wall id;
             check(d, dem_plane_wall_add(d, &w, &id), "plane wall");
         }
     } else {
@@ -101,14 +101,14 @@ static dem_domain *build(int variant, int *n_triangles)
         for (int k = 0; k < 5; k++) add_face(k, nu, k == 0 ? nu : nv_side, H, V, &nvert, T, &ntri);
         dem_mesh_def md = dem_default_mesh_def();
         md.material = mat;
-        int id;
+        dem_mesh_wall id;
         check(d, dem_mesh_wall_add(d, nvert, V, ntri, T, &md, &id), "mesh wall");
         *n_triangles = (int)ntri;
         free(V);
         free(T);
     }
     double *pos, *vel, *rad;
-    int *mats;
+    dem_material *mats;
     const int64_t n = lattice(NSIDE, NZ, mat, &pos, &vel, &rad, &mats);
     check(d, dem_particles_add(d, n, pos, rad, mats, vel, NULL, NULL), "particles");
     free(pos);

@@ -95,7 +95,7 @@ static void die(dem_domain *d, dem_status s, const char *what)
 }
 
 /* The box: material, pair constants, five frictional plane walls (open top). */
-static dem_domain *build_domain(const dem_domain_def *def, double mu_r, int *mat)
+static dem_domain *build_domain(const dem_domain_def *def, double mu_r, dem_material *mat)
 {
     dem_domain *d;
     char msg[256];
@@ -116,7 +116,7 @@ static dem_domain *build_domain(const dem_domain_def *def, double mu_r, int *mat
         w.side = faces[k][1];
         w.position = w.side > 0 ? 0.0 : def->hi[w.axis];
         w.material = *mat;
-        int id;
+        dem_plane_wall id;
         if ((s = dem_plane_wall_add(d, &w, &id)) != DEM_OK) die(d, s, "wall");
     }
     return d;
@@ -156,10 +156,10 @@ int main(int argc, char **argv)
     def.skin = 2e-4;
     def.num_threads = settle_threads;
     if (load) def.insert_overlap_ratio = 0.2; /* settled spheres touch: accept their overlaps */
-    int mat;
+    dem_material mat;
     dem_domain *d = build_domain(&def, mu_r, &mat);
     double *pos, *vel, *rad;
-    int *mats;
+    dem_material *mats;
     const int64_t n = lattice(n_side, nz, mat, &pos, &vel, &rad, &mats);
     double *angvel = calloc((size_t)(3 * n), sizeof(double));
     if (load) {

@@ -70,7 +70,7 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
                 double q[3];
                 for (int a = 0; a < 3; a++) q[a] = xi[a] - dist * pw->normal[a];
                 put(out + m, d->id[i], -1, DEM_CONTACT_PLANE, wl->wall[k], -1, q, pw->normal, wl->force + 3 * k,
-                    d->radius[i] - dist, dem_pair_props(d, d->mat[i], pw->def.material)->def.friction);
+                    d->radius[i] - dist, dem_pair_props(d, d->mat[i], pw->def.material.index)->def.friction);
             }
             m++;
         }

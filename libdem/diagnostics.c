@@ -55,7 +55,7 @@ dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
             if (delta <= 0.0) continue;
             out->contact_count++;
             out->wall_contact_count++;
-            out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], pw->def.material)->e_star, d->radius[i], delta);
+            out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], pw->def.material.index)->e_star, d->radius[i], delta);
             double ratio = delta / d->radius[i];
             if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
         }

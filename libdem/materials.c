@@ -75,7 +75,7 @@ static dem_status check_material(dem_domain *d, const dem_material_def *m)
     return DEM_OK;
 }
 
-dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *material)
+dem_status dem_material_create(dem_domain *d, const dem_material_def *def, dem_material *material)
 {
     if (!d) return DEM_ERR_NULL;
     if (!def || !material) return dem_fail(d, DEM_ERR_NULL, "dem_material_create: def and material must not be NULL");
@@ -108,7 +108,7 @@ dem_status dem_material_create(dem_domain *d, const dem_material_def *def, int *
     d->n_materials = n;
     for (int a = 0; a < n; a++) dem_pair_recompute(d, a, n_old);
     d->rayleigh_cache = -1.0;
-    *material = n_old;
+    material->index = n_old;
     dem_clear_error(d);
     return DEM_OK;
 }
@@ -123,8 +123,9 @@ static dem_status check_pair_ids(dem_domain *d, int a, int b, const char *fn)
     return DEM_OK;
 }
 
-dem_status dem_pair_set(dem_domain *d, int a, int b, const dem_pair_def *def)
+dem_status dem_pair_set(dem_domain *d, dem_material a_material, dem_material b_material, const dem_pair_def *def)
 {
+    const int a = a_material.index, b = b_material.index;
     if (!d) return DEM_ERR_NULL;
     if (!def) return dem_fail(d, DEM_ERR_NULL, "dem_pair_set: def must not be NULL");
     dem_status s = check_pair_ids(d, a, b, "dem_pair_set");
@@ -153,24 +154,27 @@ dem_status dem_pair_set(dem_domain *d, int a, int b, const dem_pair_def *def)
     return DEM_OK;
 }
 
-dem_status dem_pair_get(const dem_domain *d, int a, int b, dem_pair_def *def)
+dem_status dem_pair_get(const dem_domain *d, dem_material a_material, dem_material b_material, dem_pair_def *def)
 {
+    const int a = a_material.index, b = b_material.index;
     if (!d || !def) return DEM_ERR_NULL;
     if (a < 0 || a >= d->n_materials || b < 0 || b >= d->n_materials) return DEM_ERR_UNKNOWN_MATERIAL;
     *def = dem_pair_props(d, a, b)->def;
     return DEM_OK;
 }
 
-dem_status dem_pair_damping_factor(const dem_domain *d, int a, int b, double *factor)
+dem_status dem_pair_damping_factor(const dem_domain *d, dem_material a_material, dem_material b_material, double *factor)
 {
+    const int a = a_material.index, b = b_material.index;
     if (!d || !factor) return DEM_ERR_NULL;
     if (a < 0 || a >= d->n_materials || b < 0 || b >= d->n_materials) return DEM_ERR_UNKNOWN_MATERIAL;
     *factor = dem_pair_props(d, a, b)->damping_factor;
     return DEM_OK;
 }
 
-dem_status dem_pair_set_effect(dem_domain *d, int a, int b, const char *effect, const double *params, int n_params)
+dem_status dem_pair_set_effect(dem_domain *d, dem_material a_material, dem_material b_material, const char *effect, const double *params, int n_params)
 {
+    const int a = a_material.index, b = b_material.index;
     if (!d) return DEM_ERR_NULL;
     if (!effect) return dem_fail(d, DEM_ERR_NULL, "dem_pair_set_effect: effect name must not be NULL");
     dem_status s = check_pair_ids(d, a, b, "dem_pair_set_effect");

@@ -17,14 +17,17 @@ dem_mesh_def dem_default_mesh_def(void)
     return m;
 }
 
-static dem_status add_built_mesh(dem_domain *d, mesh_wall *m, const char *what, int *out)
+static dem_status add_built_mesh(dem_domain *d, mesh_wall *m, const char *what, dem_mesh_wall *out)
 {
     int64_t cut = dem_mesh_first_cut(d, m, d->n, d->x, d->radius);
     if (cut >= 0) {
         dem_mesh_free(m);
         return dem_fail(d, DEM_ERR_OVERLAP, "%s: the mesh cuts particle id %lld", what, (long long)d->id[cut]);
     }
-    return dem_mesh_append(d, m, what, out);
+    int k;
+    dem_status s = dem_mesh_append(d, m, what, &k);
+    if (s == DEM_OK && out) out->index = k;
+    return s;
 }
 
 static dem_status check_def(dem_domain *d, const dem_mesh_def *def, const char *fn)
@@ -35,8 +38,9 @@ static dem_status check_def(dem_domain *d, const dem_mesh_def *def, const char *
         if (!dem_is_finite(def->offset[a])) return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "%s: offset is not finite", fn);
     if (!dem_is_finite(def->weld_tolerance))
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "%s: weld_tolerance is not finite", fn);
-    if (def->material < 0 || def->material >= d->n_materials)
-        return dem_fail(d, DEM_ERR_UNKNOWN_MATERIAL, "%s: unknown material %d (%d materials exist)", fn, def->material,
+    if (def->material.index < 0 || def->material.index >= d->n_materials)
+        return dem_fail(d, DEM_ERR_UNKNOWN_MATERIAL, "%s: unknown material %d (%d materials exist)", fn,
+                        (int)def->material.index,
                         d->n_materials);
     return DEM_OK;
 }
@@ -47,7 +51,7 @@ static void transform_corners(double *xyz, int64_t n_points, const dem_mesh_def 
         for (int a = 0; a < 3; a++) xyz[3 * k + a] = xyz[3 * k + a] * def->scale + def->offset[a];
 }
 
-dem_status dem_mesh_wall_add_stl(dem_domain *d, const char *path, const dem_mesh_def *def, int *out)
+dem_status dem_mesh_wall_add_stl(dem_domain *d, const char *path, const dem_mesh_def *def, dem_mesh_wall *out)
 {
     if (!d) return DEM_ERR_NULL;
     if (!path || !def || !out) return dem_fail(d, DEM_ERR_NULL, "dem_mesh_wall_add_stl: path, def and mesh must not be NULL");
@@ -66,12 +70,12 @@ dem_status dem_mesh_wall_add_stl(dem_domain *d, const char *path, const dem_mesh
     s = dem_mesh_build(d, soup.xyz, soup.n, def->weld_tolerance, &m, what);
     dem_free(soup.xyz);
     if (s != DEM_OK) return s;
-    m.material = def->material;
+    m.material = def->material.index;
     return add_built_mesh(d, &m, what, out);
 }
 
 dem_status dem_mesh_wall_add(dem_domain *d, int64_t n_vertices, const double *vertices, int64_t n_triangles,
-                             const int32_t *triangles, const dem_mesh_def *def, int *out)
+                             const int32_t *triangles, const dem_mesh_def *def, dem_mesh_wall *out)
 {
     const char *fn = "dem_mesh_wall_add";
     if (!d) return DEM_ERR_NULL;
@@ -96,15 +100,16 @@ dem_status dem_mesh_wall_add(dem_domain *d, int64_t n_vertices, const double *ve
     s = dem_mesh_build(d, corner, n_triangles, def->weld_tolerance, &m, fn);
     dem_free(corner);
     if (s != DEM_OK) return s;
-    m.material = def->material;
+    m.material = def->material.index;
     return add_built_mesh(d, &m, fn, out);
 }
 
 /* ---- queries --------------------------------------------------------------------------- */
 int dem_mesh_wall_count(const dem_domain *d) { return d ? d->n_meshes : 0; }
 
-dem_status dem_mesh_wall_info(const dem_domain *d, int k, dem_mesh_info *info)
+dem_status dem_mesh_wall_info(const dem_domain *d, dem_mesh_wall k_handle, dem_mesh_info *info)
 {
+    const int k = k_handle.index;
     if (!d || !info) return DEM_ERR_NULL;
     if (k < 0 || k >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     const mesh_wall *m = &d->meshes[k];
@@ -130,8 +135,9 @@ dem_status dem_mesh_wall_info(const dem_domain *d, int k, dem_mesh_info *info)
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_vertices(const dem_domain *d, int k, double *vertices, int64_t capacity)
+dem_status dem_mesh_wall_get_vertices(const dem_domain *d, dem_mesh_wall k_handle, double *vertices, int64_t capacity)
 {
+    const int k = k_handle.index;
     if (!d || !vertices) return DEM_ERR_NULL;
     if (k < 0 || k >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     if (dem_check_room(d, capacity, d->meshes[k].nv, "vertices", "dem_mesh_wall_get_vertices") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;
@@ -139,8 +145,9 @@ dem_status dem_mesh_wall_get_vertices(const dem_domain *d, int k, double *vertic
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_triangles(const dem_domain *d, int k, int32_t *triangles, int64_t capacity)
+dem_status dem_mesh_wall_get_triangles(const dem_domain *d, dem_mesh_wall k_handle, int32_t *triangles, int64_t capacity)
 {
+    const int k = k_handle.index;
     if (!d || !triangles) return DEM_ERR_NULL;
     if (k < 0 || k >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     if (dem_check_room(d, capacity, d->meshes[k].nt, "triangles", "dem_mesh_wall_get_triangles") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;

@@ -15,8 +15,9 @@ void dem_mesh_total_force(const dem_domain *d, int mesh, double force[3])
             for (int a = 0; a < 3; a++) force[a] -= tl->force[3 * k + a];
 }
 
-dem_status dem_mesh_wall_force(const dem_domain *d, int mesh, const double point[3], double force[3], double torque[3])
+dem_status dem_mesh_wall_force(const dem_domain *d, dem_mesh_wall mesh_handle, const double point[3], double force[3], double torque[3])
 {
+    const int mesh = mesh_handle.index;
     if (!d || !force) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     const double origin[3] = {0.0, 0.0, 0.0};
@@ -37,8 +38,9 @@ dem_status dem_mesh_wall_force(const dem_domain *d, int mesh, const double point
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_triangle_forces(const dem_domain *d, int mesh, double *forces, int64_t capacity)
+dem_status dem_mesh_wall_triangle_forces(const dem_domain *d, dem_mesh_wall mesh_handle, double *forces, int64_t capacity)
 {
+    const int mesh = mesh_handle.index;
     if (!d || !forces) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     if (dem_check_room(d, capacity, d->meshes[mesh].nt, "triangles", "dem_mesh_wall_triangle_forces") != DEM_OK) return DEM_ERR_INVALID_ARGUMENT;
@@ -50,9 +52,10 @@ dem_status dem_mesh_wall_triangle_forces(const dem_domain *d, int mesh, double *
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_stress(const dem_domain *d, int mesh, const double normal[3], double area, double *sn,
+dem_status dem_mesh_wall_stress(const dem_domain *d, dem_mesh_wall mesh_handle, const double normal[3], double area, double *sn,
                                 double *tau)
 {
+    const int mesh = mesh_handle.index;
     if (!d || !normal || !sn || !tau) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     double len = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);

@@ -126,9 +126,10 @@ static void update_moving(mesh_wall *m)
     for (int a = 0; a < 3; a++) m->moving |= (m->velocity[a] != 0.0) | (m->omega[a] != 0.0);
 }
 
-dem_status dem_mesh_wall_set_motion(dem_domain *d, int mesh, const double velocity[3], const double angular_velocity[3],
+dem_status dem_mesh_wall_set_motion(dem_domain *d, dem_mesh_wall mesh_handle, const double velocity[3], const double angular_velocity[3],
                                     const double centre[3])
 {
+    const int mesh = mesh_handle.index;
     const char *fn = "dem_mesh_wall_set_motion";
     if (!d) return DEM_ERR_NULL;
     if (!velocity) return dem_fail(d, DEM_ERR_NULL, "%s: velocity must not be NULL", fn);
@@ -151,8 +152,9 @@ dem_status dem_mesh_wall_set_motion(dem_domain *d, int mesh, const double veloci
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_set_servo(dem_domain *d, int mesh, const dem_servo_def *def)
+dem_status dem_mesh_wall_set_servo(dem_domain *d, dem_mesh_wall mesh_handle, const dem_servo_def *def)
 {
+    const int mesh = mesh_handle.index;
     const char *fn = "dem_mesh_wall_set_servo";
     if (!d) return DEM_ERR_NULL;
     if (!def) return dem_fail(d, DEM_ERR_NULL, "%s: def must not be NULL", fn);
@@ -185,8 +187,9 @@ dem_status dem_mesh_wall_set_servo(dem_domain *d, int mesh, const dem_servo_def 
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_servo_off(dem_domain *d, int mesh)
+dem_status dem_mesh_wall_servo_off(dem_domain *d, dem_mesh_wall mesh_handle)
 {
+    const int mesh = mesh_handle.index;
     if (!d) return DEM_ERR_NULL;
     mesh_wall *m = NULL;
     dem_status s = get_mesh(d, mesh, "dem_mesh_wall_servo_off", &m);
@@ -198,8 +201,9 @@ dem_status dem_mesh_wall_servo_off(dem_domain *d, int mesh)
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_pose(const dem_domain *d, int mesh, double translation[3], double rotation[9])
+dem_status dem_mesh_wall_get_pose(const dem_domain *d, dem_mesh_wall mesh_handle, double translation[3], double rotation[9])
 {
+    const int mesh = mesh_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     if (translation) memcpy(translation, d->meshes[mesh].trans, 3 * sizeof(double));
@@ -207,8 +211,9 @@ dem_status dem_mesh_wall_get_pose(const dem_domain *d, int mesh, double translat
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_get_velocity(const dem_domain *d, int mesh, double velocity[3], double angular_velocity[3])
+dem_status dem_mesh_wall_get_velocity(const dem_domain *d, dem_mesh_wall mesh_handle, double velocity[3], double angular_velocity[3])
 {
+    const int mesh = mesh_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     if (velocity) memcpy(velocity, d->meshes[mesh].velocity, 3 * sizeof(double));

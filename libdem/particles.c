@@ -136,7 +136,7 @@ static int64_t find_overlap(dem_domain *d, int64_t n_new, const double *pos, con
     return found;
 }
 
-dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const double *rad, const int *material,
+dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const double *rad, const dem_material *material,
                              const double *vel, const double *angvel, dem_particle_id *ids)
 {
     if (!d) return DEM_ERR_NULL;
@@ -169,10 +169,10 @@ dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const 
             return dem_fail(d, DEM_ERR_INVALID_ARGUMENT,
                             "dem_particles_add: particle %lld: radius must be finite and > 0 m, got %g", (long long)k,
                             rad[k]);
-        if (material[k] < 0 || material[k] >= d->n_materials)
+        if (material[k].index < 0 || material[k].index >= d->n_materials)
             return dem_fail(d, DEM_ERR_UNKNOWN_MATERIAL,
                             "dem_particles_add: particle %lld: unknown material %d (%d materials exist)", (long long)k,
-                            material[k], d->n_materials);
+                            (int)material[k].index, d->n_materials);
         for (int w = 0; w < d->n_walls; w++) {
             const plane_wall *pw = &d->walls[w];
             double dist = (pos[3 * k + pw->def.axis] - pw->def.position) * pw->def.side;
@@ -201,7 +201,7 @@ dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const 
         return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_particles_add: out of memory for %lld particles", (long long)(d->n + n));
     for (int64_t k = 0; k < n; k++) {
         int64_t i = d->n + k;
-        const dem_material_def *m = &d->materials[material[k]];
+        const dem_material_def *m = &d->materials[material[k].index];
         double r = rad[k];
         double mass = m->density * 4.0 / 3.0 * DEM_PI * r * r * r;
         for (int a = 0; a < 3; a++) {
@@ -213,7 +213,7 @@ dem_status dem_particles_add(dem_domain *d, int64_t n, const double *pos, const 
         d->radius[i] = r;
         d->inv_mass[i] = 1.0 / mass;
         d->inv_inertia[i] = 1.0 / (0.4 * mass * r * r);
-        d->mat[i] = material[k];
+        d->mat[i] = material[k].index;
         d->id[i] = d->next_id;
         d->index_of_id[d->next_id] = (int32_t)i;
         if (ids) ids[k] = d->next_id;

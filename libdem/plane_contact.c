@@ -60,7 +60,7 @@ void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         const double ci = wall_contact_in(&c, pw->normal, dist, ri, d->inv_mass[i], vi, wi, pw->def.velocity, no_spin);
         if (c.overlap > d->def.max_overlap_ratio * ri && i < *bad) *bad = i;
         contact_out o;
-        contact_law(&row_pairs[pw->def.material], &c, dt_hist, hxi, hmr, &o);
+        contact_law(&row_pairs[pw->def.material.index], &c, dt_hist, hxi, hmr, &o);
         for (int a = 0; a < 3; a++) {
             f[a] += o.force[a];
             t[a] += -ci * o.cross[a] + o.mr[a];

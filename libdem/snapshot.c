@@ -183,7 +183,7 @@ static int write_walls(hid_t f, const dem_domain *d)
         const dem_plane_wall_def *p = &d->walls[w].def;
         iv[3 * w] = p->axis;
         iv[3 * w + 1] = p->side;
-        iv[3 * w + 2] = p->material;
+        iv[3 * w + 2] = p->material.index;
         dv[4 * w] = p->position;
         memcpy(dv + 4 * w + 1, p->velocity, 3 * sizeof(double));
     }

@@ -162,7 +162,7 @@ static dem_status read_materials(reader *r)
     }
     for (int64_t m = 0; m < nm; m++) {
         dem_material_def md = {e[m], nu[m], rho[m], gmod[m]};
-        int id;
+        dem_material id;
         dem_status s = dem_material_create(d, &md, &id);
         if (s != DEM_OK) {
             st = lib_fail(r, s);
@@ -173,7 +173,7 @@ static dem_status read_materials(reader *r)
         for (int64_t b = a; b < nm; b++) {
             const double *p = pairs + 4 * (a * nm + b);
             dem_pair_def pd = {p[0], p[1], p[2], (dem_rolling_model)model[a * nm + b], p[3]};
-            dem_status s = dem_pair_set(d, (int)a, (int)b, &pd);
+            dem_status s = dem_pair_set(d, (dem_material){(int32_t)a}, (dem_material){(int32_t)b}, &pd);
             if (s != DEM_OK) {
                 st = lib_fail(r, s);
                 goto out;
@@ -214,7 +214,7 @@ static dem_status read_materials(reader *r)
             goto out;
         }
         if (eidx[3 * k] > eidx[3 * k + 1]) continue; /* symmetric: set once */
-        dem_status s = dem_pair_set_effect(d, eidx[3 * k], eidx[3 * k + 1], name, epar + DEM_MAX_EFFECT_PARAMS * k,
+        dem_status s = dem_pair_set_effect(d, (dem_material){eidx[3 * k]}, (dem_material){eidx[3 * k + 1]}, name, epar + DEM_MAX_EFFECT_PARAMS * k,
                                            dem_effect_get(ei)->n_params);
         if (s != DEM_OK) {
             st = lib_fail(r, s);
@@ -333,10 +333,10 @@ static dem_status read_walls(reader *r)
         dem_plane_wall_def p = dem_default_plane_wall_def();
         p.axis = iv[3 * w];
         p.side = iv[3 * w + 1];
-        p.material = iv[3 * w + 2];
+        p.material.index = iv[3 * w + 2];
         p.position = dv[4 * w];
         memcpy(p.velocity, dv + 4 * w + 1, 3 * sizeof(double));
-        int id;
+        dem_plane_wall id;
         dem_status s = dem_plane_wall_add(r->d, &p, &id);
         if (s != DEM_OK) {
             st = lib_fail(r, s);

@@ -60,7 +60,7 @@ dem_status dem_domain_timestep_info(dem_domain *d, dem_timestep_info *info)
             if (t < tc) tc = t;
         }
         for (int w = 0; w < d->n_walls + d->n_meshes; w++) {
-            int wm = w < d->n_walls ? d->walls[w].def.material : d->meshes[w - d->n_walls].material;
+            int wm = w < d->n_walls ? d->walls[w].def.material.index : d->meshes[w - d->n_walls].material;
             double t = hertz_time(dem_pair_props(d, a, wm)->e_star, rmin[a], ma, v);
             if (t < tc) tc = t;
         }

@@ -88,8 +88,9 @@ dem_status dem_vtk_write_particles(dem_domain *d, const char *path)
     return close_vtu(d, fp, path, "dem_vtk_write_particles");
 }
 
-dem_status dem_vtk_write_mesh(dem_domain *d, int mesh, const char *path)
+dem_status dem_vtk_write_mesh(dem_domain *d, dem_mesh_wall mesh_handle, const char *path)
 {
+    const int mesh = mesh_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (!path) return dem_fail(d, DEM_ERR_NULL, "dem_vtk_write_mesh: path must not be NULL");
     if (mesh < 0 || mesh >= d->n_meshes)
@@ -102,7 +103,7 @@ dem_status dem_vtk_write_mesh(dem_domain *d, int mesh, const char *path)
     const int64_t nv = d->meshes[mesh].nv, nt = d->meshes[mesh].nt;
     double *force = dem_malloc((size_t)(nt > 0 ? nt : 1) * 3 * sizeof(double));
     if (!force) return dem_fail(d, DEM_ERR_NO_MEMORY, "dem_vtk_write_mesh: out of memory");
-    dem_mesh_wall_triangle_forces(d, mesh, force, nt);
+    dem_mesh_wall_triangle_forces(d, mesh_handle, force, nt);
     FILE *fp = open_vtu(d, path, "dem_vtk_write_mesh", nv, nt);
     if (!fp) {
         dem_free(force);

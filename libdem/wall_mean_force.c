@@ -45,8 +45,9 @@ void dem_walls_accumulate_mean_force(dem_domain *d, double dt)
     }
 }
 
-dem_status dem_mesh_wall_reset_mean_force(dem_domain *d, int mesh)
+dem_status dem_mesh_wall_reset_mean_force(dem_domain *d, dem_mesh_wall mesh_handle)
 {
+    const int mesh = mesh_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes)
         return dem_fail(d, DEM_ERR_UNKNOWN_WALL, "dem_mesh_wall_reset_mean_force: unknown mesh wall %d (%d exist)", mesh,
@@ -60,9 +61,10 @@ dem_status dem_mesh_wall_reset_mean_force(dem_domain *d, int mesh)
     return DEM_OK;
 }
 
-dem_status dem_mesh_wall_mean_force(const dem_domain *d, int mesh, const double point[3], double force[3],
+dem_status dem_mesh_wall_mean_force(const dem_domain *d, dem_mesh_wall mesh_handle, const double point[3], double force[3],
                                     double torque[3], double *seconds)
 {
+    const int mesh = mesh_handle.index;
     if (!d || !force) return DEM_ERR_NULL;
     if (mesh < 0 || mesh >= d->n_meshes) return DEM_ERR_UNKNOWN_WALL;
     const mesh_wall *m = &d->meshes[mesh];
@@ -82,8 +84,9 @@ dem_status dem_mesh_wall_mean_force(const dem_domain *d, int mesh, const double 
     return DEM_OK;
 }
 
-dem_status dem_plane_wall_reset_mean_force(dem_domain *d, int wall)
+dem_status dem_plane_wall_reset_mean_force(dem_domain *d, dem_plane_wall wall_handle)
 {
+    const int wall = wall_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (wall < 0 || wall >= d->n_walls)
         return dem_fail(d, DEM_ERR_UNKNOWN_WALL, "dem_plane_wall_reset_mean_force: unknown plane wall %d (%d exist)", wall,
@@ -96,8 +99,9 @@ dem_status dem_plane_wall_reset_mean_force(dem_domain *d, int wall)
     return DEM_OK;
 }
 
-dem_status dem_plane_wall_mean_force(const dem_domain *d, int wall, double force[3], double *seconds)
+dem_status dem_plane_wall_mean_force(const dem_domain *d, dem_plane_wall wall_handle, double force[3], double *seconds)
 {
+    const int wall = wall_handle.index;
     if (!d || !force) return DEM_ERR_NULL;
     if (wall < 0 || wall >= d->n_walls) return DEM_ERR_UNKNOWN_WALL;
     const plane_wall *p = &d->walls[wall];

@@ -9,7 +9,7 @@ dem_plane_wall_def dem_default_plane_wall_def(void)
     w.axis = 2;
     w.side = 1;
     w.position = 0.0;
-    w.material = 0;
+    w.material.index = 0;
     return w;
 }
 
@@ -20,7 +20,7 @@ static dem_status check_velocity(dem_domain *d, const double *v, const char *fn)
     return DEM_OK;
 }
 
-dem_status dem_plane_wall_add(dem_domain *d, const dem_plane_wall_def *def, int *wall)
+dem_status dem_plane_wall_add(dem_domain *d, const dem_plane_wall_def *def, dem_plane_wall *wall)
 {
     if (!d) return DEM_ERR_NULL;
     if (!def || !wall) return dem_fail(d, DEM_ERR_NULL, "dem_plane_wall_add: def and wall must not be NULL");
@@ -30,9 +30,9 @@ dem_status dem_plane_wall_add(dem_domain *d, const dem_plane_wall_def *def, int 
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_plane_wall_add: side must be +1 or -1, got %d", def->side);
     if (!dem_is_finite(def->position))
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_plane_wall_add: position is not finite");
-    if (def->material < 0 || def->material >= d->n_materials)
+    if (def->material.index < 0 || def->material.index >= d->n_materials)
         return dem_fail(d, DEM_ERR_UNKNOWN_MATERIAL, "dem_plane_wall_add: unknown material %d (%d materials exist)",
-                        def->material, d->n_materials);
+                        (int)def->material.index, d->n_materials);
     dem_status s = check_velocity(d, def->velocity, "dem_plane_wall_add");
     if (s != DEM_OK) return s;
     for (int64_t i = 0; i < d->n; i++) {
@@ -51,15 +51,16 @@ dem_status dem_plane_wall_add(dem_domain *d, const dem_plane_wall_def *def, int 
     memset(w, 0, sizeof *w);
     w->def = *def;
     w->normal[def->axis] = (double)def->side;
-    *wall = d->n_walls++;
+    wall->index = d->n_walls++;
     d->need_rebuild = 1;
     d->forces_valid = 0;
     dem_clear_error(d);
     return DEM_OK;
 }
 
-dem_status dem_plane_wall_set_velocity(dem_domain *d, int wall, const double velocity[3])
+dem_status dem_plane_wall_set_velocity(dem_domain *d, dem_plane_wall wall_handle, const double velocity[3])
 {
+    const int wall = wall_handle.index;
     if (!d) return DEM_ERR_NULL;
     if (!velocity) return dem_fail(d, DEM_ERR_NULL, "dem_plane_wall_set_velocity: velocity must not be NULL");
     if (wall < 0 || wall >= d->n_walls)
@@ -72,8 +73,9 @@ dem_status dem_plane_wall_set_velocity(dem_domain *d, int wall, const double vel
     return DEM_OK;
 }
 
-dem_status dem_plane_wall_force(const dem_domain *d, int wall, double force[3])
+dem_status dem_plane_wall_force(const dem_domain *d, dem_plane_wall wall_handle, double force[3])
 {
+    const int wall = wall_handle.index;
     if (!d || !force) return DEM_ERR_NULL;
     if (wall < 0 || wall >= d->n_walls) return DEM_ERR_UNKNOWN_WALL;
     force[0] = force[1] = force[2] = 0.0;

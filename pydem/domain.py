@@ -65,7 +65,7 @@ def c_definition(maker, ctype: str, **given):
         if value is None:
             continue
         field = getattr(s, key)
-        if isinstance(field, ffi.CData):  # a fixed array (lo, hi, gravity, ...)
+        if isinstance(field, ffi.CData) and ffi.typeof(field).kind == "array":  # lo, hi, gravity, ...
             for a, x in enumerate(value):
                 field[a] = x
         else:
@@ -157,9 +157,9 @@ class Domain:
         isotropic: G = E / (2 (1 + nu))); shear_modulus gives G apart from E and nu."""
         m = c_definition(lib.dem_default_material_def, "dem_material_def *", youngs_modulus=youngs_modulus,
                          poisson_ratio=poisson_ratio, density=density, shear_modulus=shear_modulus)
-        out = ffi.new("int *")
+        out = ffi.new("dem_material *")
         self._check(lib.dem_material_create(self._d, m, out))
-        return out[0]
+        return out.index
 
     @property
     def material_count(self) -> int:
@@ -177,11 +177,11 @@ class Domain:
                          rolling_friction=rolling_friction,
                          rolling_model=None if rolling_model is None else ROLLING_MODELS[rolling_model],
                          rolling_damping=rolling_damping)
-        self._check(lib.dem_pair_set(self._d, a, b, p))
+        self._check(lib.dem_pair_set(self._d, [a], [b], p))
 
     def get_pair(self, a: int, b: int) -> dict:
         p = ffi.new("dem_pair_def *")
-        self._check(lib.dem_pair_get(self._d, a, b, p))
+        self._check(lib.dem_pair_get(self._d, [a], [b], p))
         model = {v: k for k, v in ROLLING_MODELS.items()}[p.rolling_model]
         return {"restitution": p.restitution, "friction": p.friction, "rolling_friction": p.rolling_friction,
                 "rolling_model": model, "rolling_damping": p.rolling_damping}
@@ -191,7 +191,7 @@ class Domain:
         requested one with the normal force clipped at zero: gamma_n = factor sqrt(S_n m*)
         (docs/libdem.md, "Restitution")."""
         out = ffi.new("double *")
-        self._check(lib.dem_pair_damping_factor(self._d, a, b, out))
+        self._check(lib.dem_pair_damping_factor(self._d, [a], [b], out))
         return float(out[0])
 
     def set_effect(self, a: int, b: int, name: str, *values: float, **named: float):
@@ -210,7 +210,7 @@ class Domain:
         if named:
             raise DemInvalidArgument(f"effect {name!r} has no parameter(s) {sorted(named)}", "DEM_ERR_INVALID_ARGUMENT")
         arr = ffi.new("double[]", [float(v) for v in params] or [0.0])
-        self._check(lib.dem_pair_set_effect(self._d, a, b, name.encode(), arr, len(params)))
+        self._check(lib.dem_pair_set_effect(self._d, [a], [b], name.encode(), arr, len(params)))
 
     # ---- particles -------------------------------------------------------------------------
     def add_particles(self, positions, radii, materials, velocities=None, angular_velocities=None) -> np.ndarray:
@@ -222,7 +222,7 @@ class Domain:
         vel = None if velocities is None else _array(velocities, np.float64, (3,), "velocities", n)
         ang = None if angular_velocities is None else _array(angular_velocities, np.float64, (3,), "angular_velocities", n)
         ids = np.empty(n, dtype=np.int64)
-        self._check(lib.dem_particles_add(self._d, n, _ptr(pos, "double[]"), _ptr(rad, "double[]"), _ptr(mat, "int[]"),
+        self._check(lib.dem_particles_add(self._d, n, _ptr(pos, "double[]"), _ptr(rad, "double[]"), _ptr(mat, "dem_material[]"),
                                           ffi.NULL if vel is None else _ptr(vel, "double[]"),
                                           ffi.NULL if ang is None else _ptr(ang, "double[]"),
                                           _ptr(ids, "int64_t[]")))
@@ -375,7 +375,7 @@ class Domain:
 
     def write_mesh_vtk(self, mesh: int, path: str | os.PathLike):
         """Mesh wall `mesh` at its current pose as a VTK .vtu file, with each triangle's force."""
-        self._check(lib.dem_vtk_write_mesh(self._d, int(mesh), os.fsencode(path)))
+        self._check(lib.dem_vtk_write_mesh(self._d, [int(mesh)], os.fsencode(path)))
 
     def _render_def(self, width, height, view_axis, window, color, scalar, scalar_range, walls, background):
         r = lib.dem_default_render_def()

@@ -49,15 +49,15 @@ DEM_API size_t dem_domain_memory_bytes(const dem_domain *domain);
 
 /* ---- materials and material pairs ---------------------------------------------- */
 DEM_API dem_material_def dem_default_material_def(void);   /* glass-like: E 5 MPa, nu 0.25, rho 2500 */
-DEM_API dem_status dem_material_create(dem_domain *domain, const dem_material_def *def, int *material);
+DEM_API dem_status dem_material_create(dem_domain *domain, const dem_material_def *def, dem_material *material);
 DEM_API int dem_material_count(const dem_domain *domain);
 DEM_API dem_pair_def dem_default_pair_def(void);            /* e 0.5, mu_s 0.5, mu_r 0, EPSD2 */
 /* Sets the constants of pair (a, b) (symmetric). Pairs never set use dem_default_pair_def(). */
-DEM_API dem_status dem_pair_set(dem_domain *domain, int material_a, int material_b, const dem_pair_def *def);
-DEM_API dem_status dem_pair_get(const dem_domain *domain, int material_a, int material_b, dem_pair_def *def);
+DEM_API dem_status dem_pair_set(dem_domain *domain, dem_material a, dem_material b, const dem_pair_def *def);
+DEM_API dem_status dem_pair_get(const dem_domain *domain, dem_material a, dem_material b, dem_pair_def *def);
 /* The damping constant actually used so that the delivered restitution equals the requested
  * one with the normal force clipped at zero (gamma = factor * sqrt(S m*)). */
-DEM_API dem_status dem_pair_damping_factor(const dem_domain *domain, int material_a, int material_b,
+DEM_API dem_status dem_pair_damping_factor(const dem_domain *domain, dem_material a, dem_material b,
                                            double *factor);
 
 /* ---- effects (optional physics, see docs/effects.md) ----------------------------- */
@@ -69,7 +69,7 @@ DEM_API dem_status dem_effect_param_info(int index, int param, const char **name
                                          double *neutral);
 /* Switches an effect on for a material pair with the given parameters (all of them).
  * Setting every parameter to its neutral value switches it off. */
-DEM_API dem_status dem_pair_set_effect(dem_domain *domain, int material_a, int material_b,
+DEM_API dem_status dem_pair_set_effect(dem_domain *domain, dem_material a, dem_material b,
                                        const char *effect, const double *params, int n_params);
 
 /* ---- particles ------------------------------------------------------------------- */
@@ -78,7 +78,7 @@ DEM_API dem_status dem_pair_set_effect(dem_domain *domain, int material_a, int m
  * bad value (NaN, radius <= 0, unknown material, outside bounds, overlap with a particle
  * or wall beyond insert_overlap_ratio) nothing is added and the message names the index. */
 DEM_API dem_status dem_particles_add(dem_domain *domain, int64_t n, const double *position,
-                                     const double *radius, const int *material, const double *velocity,
+                                     const double *radius, const dem_material *material, const double *velocity,
                                      const double *angular_velocity, dem_particle_id *ids);
 DEM_API dem_status dem_particles_remove(dem_domain *domain, int64_t n, const dem_particle_id *ids);
 DEM_API int64_t dem_particle_count(const dem_domain *domain);
@@ -99,15 +99,15 @@ DEM_API dem_status dem_particles_set_angular_velocities(dem_domain *domain, cons
 
 /* ---- analytic plane walls -------------------------------------------------------- */
 DEM_API dem_plane_wall_def dem_default_plane_wall_def(void); /* floor z >= 0, material 0 */
-DEM_API dem_status dem_plane_wall_add(dem_domain *domain, const dem_plane_wall_def *def, int *wall);
-DEM_API dem_status dem_plane_wall_set_velocity(dem_domain *domain, int wall, const double velocity[3]);
+DEM_API dem_status dem_plane_wall_add(dem_domain *domain, const dem_plane_wall_def *def, dem_plane_wall *wall);
+DEM_API dem_status dem_plane_wall_set_velocity(dem_domain *domain, dem_plane_wall wall, const double velocity[3]);
 /* Total force exerted by the particles on the wall during the last step (N). */
-DEM_API dem_status dem_plane_wall_force(const dem_domain *domain, int wall, double force[3]);
+DEM_API dem_status dem_plane_wall_force(const dem_domain *domain, dem_plane_wall wall, double force[3]);
 /* Time-averaged force (N) over the steps since the last reset (as for mesh walls, mesh.h):
  * reset starts or restarts the average; *seconds (may be NULL) gets the time averaged over, and
  * the force is zero before the first step. Not part of snapshots. */
-DEM_API dem_status dem_plane_wall_reset_mean_force(dem_domain *domain, int wall);
-DEM_API dem_status dem_plane_wall_mean_force(const dem_domain *domain, int wall, double force[3], double *seconds);
+DEM_API dem_status dem_plane_wall_reset_mean_force(dem_domain *domain, dem_plane_wall wall);
+DEM_API dem_status dem_plane_wall_mean_force(const dem_domain *domain, dem_plane_wall wall, double force[3], double *seconds);
 
 #ifdef __cplusplus
 }

@@ -30,7 +30,7 @@ DEM_API dem_status dem_snapshot_read(const char *path, dem_domain **out, char *m
  * Forces are brought up to date first when needed (as dem_domain_step(d, 0)). DEM_ERR_IO when
  * the file cannot be written; DEM_ERR_UNKNOWN_WALL for a mesh index out of range. */
 DEM_API dem_status dem_vtk_write_particles(dem_domain *domain, const char *path);
-DEM_API dem_status dem_vtk_write_mesh(dem_domain *domain, int mesh, const char *path);
+DEM_API dem_status dem_vtk_write_mesh(dem_domain *domain, dem_mesh_wall mesh, const char *path);
 
 typedef enum dem_color_mode {
     DEM_COLOR_MATERIAL = 0, /* a fixed palette by material */

@@ -17,7 +17,7 @@ typedef struct dem_mesh_def {
     double scale;          /* coordinates are multiplied by this on load (1e-3 for mm files), > 0 */
     double offset[3];      /* m, added after scaling */
     double weld_tolerance; /* m, vertices closer than this are merged; <= 0: 1e-6 x bounding-box diagonal */
-    int material;          /* wall material */
+    dem_material material; /* wall material */
 } dem_mesh_def;
 
 /* What the loader found. */
@@ -56,51 +56,51 @@ DEM_API dem_servo_def dem_default_servo_def(void);
  * skipped and counted (dem_mesh_wall_info). Fails with DEM_ERR_IO (cannot read) or
  * DEM_ERR_FORMAT (malformed, NaN/inf, size mismatch), naming the problem; the domain is
  * unchanged then. Particles the mesh would cut are refused with DEM_ERR_OVERLAP. */
-DEM_API dem_status dem_mesh_wall_add_stl(dem_domain *domain, const char *path, const dem_mesh_def *def, int *mesh);
+DEM_API dem_status dem_mesh_wall_add_stl(dem_domain *domain, const char *path, const dem_mesh_def *def, dem_mesh_wall *mesh);
 /* Same from caller arrays: vertices 3 x n_vertices (m, before scale/offset), triangles
  * 3 x n_triangles vertex indices. */
 DEM_API dem_status dem_mesh_wall_add(dem_domain *domain, int64_t n_vertices, const double *vertices,
                                      int64_t n_triangles, const int32_t *triangles, const dem_mesh_def *def,
-                                     int *mesh);
+                                     dem_mesh_wall *mesh);
 DEM_API int dem_mesh_wall_count(const dem_domain *domain);
-DEM_API dem_status dem_mesh_wall_info(const dem_domain *domain, int mesh, dem_mesh_info *info);
+DEM_API dem_status dem_mesh_wall_info(const dem_domain *domain, dem_mesh_wall mesh, dem_mesh_info *info);
 /* Current (moved) vertices, 3 x vertex_count, and triangles, 3 x triangle_count, into buffers
  * with room for `capacity` vertices / triangles (DEM_ERR_INVALID_ARGUMENT when too small). */
-DEM_API dem_status dem_mesh_wall_get_vertices(const dem_domain *domain, int mesh, double *vertices, int64_t capacity);
-DEM_API dem_status dem_mesh_wall_get_triangles(const dem_domain *domain, int mesh, int32_t *triangles,
+DEM_API dem_status dem_mesh_wall_get_vertices(const dem_domain *domain, dem_mesh_wall mesh, double *vertices, int64_t capacity);
+DEM_API dem_status dem_mesh_wall_get_triangles(const dem_domain *domain, dem_mesh_wall mesh, int32_t *triangles,
                                                int64_t capacity);
 
 /* Prescribed rigid motion from now on: translation velocity (m/s) plus rotation at
  * angular_velocity (rad/s, vector along the axis) about an axis through `centre` (m, a point
  * that moves with the wall). NULL angular_velocity/centre: no rotation. Changeable between
  * steps; contacts feel the surface velocity v + w x (p - c). Switches a servo off. */
-DEM_API dem_status dem_mesh_wall_set_motion(dem_domain *domain, int mesh, const double velocity[3],
+DEM_API dem_status dem_mesh_wall_set_motion(dem_domain *domain, dem_mesh_wall mesh, const double velocity[3],
                                             const double angular_velocity[3], const double centre[3]);
 /* Load control (replaces the translation velocity; a rotation set before is kept). */
-DEM_API dem_status dem_mesh_wall_set_servo(dem_domain *domain, int mesh, const dem_servo_def *def);
-DEM_API dem_status dem_mesh_wall_servo_off(dem_domain *domain, int mesh);
+DEM_API dem_status dem_mesh_wall_set_servo(dem_domain *domain, dem_mesh_wall mesh, const dem_servo_def *def);
+DEM_API dem_status dem_mesh_wall_servo_off(dem_domain *domain, dem_mesh_wall mesh);
 /* Rigid pose relative to the loaded mesh: x = R x0 + t (R row-major 3x3). */
-DEM_API dem_status dem_mesh_wall_get_pose(const dem_domain *domain, int mesh, double translation[3],
+DEM_API dem_status dem_mesh_wall_get_pose(const dem_domain *domain, dem_mesh_wall mesh, double translation[3],
                                           double rotation[9]);
-DEM_API dem_status dem_mesh_wall_get_velocity(const dem_domain *domain, int mesh, double velocity[3],
+DEM_API dem_status dem_mesh_wall_get_velocity(const dem_domain *domain, dem_mesh_wall mesh, double velocity[3],
                                               double angular_velocity[3]);
 
 /* Total force the particles exerted on the wall during the last step (N), and its torque
  * about `point` (N m); point NULL: the origin. */
-DEM_API dem_status dem_mesh_wall_force(const dem_domain *domain, int mesh, const double point[3], double force[3],
+DEM_API dem_status dem_mesh_wall_force(const dem_domain *domain, dem_mesh_wall mesh, const double point[3], double force[3],
                                        double torque[3]);
 /* Time average of the wall force over every step since the last reset: a lid's stress without
  * the step-to-step rattle of a snapshot. Reset starts (or restarts) the average; the mean is
  * sum(F dt) / sum(dt) and its torque about `point` (NULL: the origin); `seconds` receives the
  * averaged time (0, and zero force, when no step was taken since the reset). */
-DEM_API dem_status dem_mesh_wall_reset_mean_force(dem_domain *domain, int mesh);
-DEM_API dem_status dem_mesh_wall_mean_force(const dem_domain *domain, int mesh, const double point[3],
+DEM_API dem_status dem_mesh_wall_reset_mean_force(dem_domain *domain, dem_mesh_wall mesh);
+DEM_API dem_status dem_mesh_wall_mean_force(const dem_domain *domain, dem_mesh_wall mesh, const double point[3],
                                             double force[3], double torque[3], double *seconds);
 /* Force on each triangle, 3 x triangle_count (N), into a buffer with room for `capacity` triangles. */
-DEM_API dem_status dem_mesh_wall_triangle_forces(const dem_domain *domain, int mesh, double *forces, int64_t capacity);
+DEM_API dem_status dem_mesh_wall_triangle_forces(const dem_domain *domain, dem_mesh_wall mesh, double *forces, int64_t capacity);
 /* Normal and shear stress of the wall force over `area` (m^2) for the unit `normal`:
  * sigma_n = F.n / A, tau = |F - (F.n) n| / A (Pa). */
-DEM_API dem_status dem_mesh_wall_stress(const dem_domain *domain, int mesh, const double normal[3], double area,
+DEM_API dem_status dem_mesh_wall_stress(const dem_domain *domain, dem_mesh_wall mesh, const double normal[3], double area,
                                         double *normal_stress, double *shear_stress);
 
 #ifdef __cplusplus

@@ -11,6 +11,13 @@ extern "C" {
 typedef struct dem_domain dem_domain; /* opaque */
 typedef int64_t dem_particle_id;       /* stable across sorting, removal and restarts */
 
+/* Typed handles: a material, a plane wall or a mesh wall is named by a struct holding its index
+ * (0, 1, ... in creation order), so passing one kind where another is expected does not compile.
+ * Arrays of materials (one per particle) are arrays of dem_material: int32 indices in memory. */
+typedef struct dem_material { int32_t index; } dem_material;
+typedef struct dem_plane_wall { int32_t index; } dem_plane_wall;
+typedef struct dem_mesh_wall { int32_t index; } dem_mesh_wall;
+
 /* The simulation box. Closed axes: a particle leaving [lo, hi] is an error
  * (DEM_ERR_OUT_OF_BOUNDS); periodic axes wrap. */
 typedef struct dem_domain_def {
@@ -56,7 +63,7 @@ typedef struct dem_plane_wall_def {
     int axis;          /* 0, 1, 2 */
     int side;          /* +1 or -1: direction of the wall normal, pointing into the domain */
     double position;   /* m */
-    int material;      /* wall material id */
+    dem_material material; /* wall material */
     double velocity[3];/* m/s, surface velocity felt by the contacts (the plane does not move) */
 } dem_plane_wall_def;
 

@@ -30,9 +30,9 @@ static inline void grid_rectangle(double x0, double x1, double y0, double y1, do
         }
 }
 
-/* Adds grid_rectangle(...) as a mesh wall of the given material; returns its index. */
-static inline int add_grid_mesh(dem_domain *d, double x0, double x1, double y0, double y1, double z, int nx, int ny,
-                                int material)
+/* Adds grid_rectangle(...) as a mesh wall of the given material; returns its handle. */
+static inline dem_mesh_wall add_grid_mesh(dem_domain *d, double x0, double x1, double y0, double y1, double z, int nx,
+                                          int ny, dem_material material)
 {
     double *v;
     int32_t *t;
@@ -40,7 +40,7 @@ static inline int add_grid_mesh(dem_domain *d, double x0, double x1, double y0, 
     grid_rectangle(x0, x1, y0, y1, z, nx, ny, &v, &nv, &t, &nt);
     dem_mesh_def md = dem_default_mesh_def();
     md.material = material;
-    int mesh = -1;
+    dem_mesh_wall mesh = {-1};
     assert_ok(dem_mesh_wall_add(d, nv, v, nt, t, &md, &mesh));
     free(v);
     free(t);
@@ -49,7 +49,7 @@ static inline int add_grid_mesh(dem_domain *d, double x0, double x1, double y0, 
 
 /* An open box (floor + four sides, no lid) [0, L] x [0, L] x [0, H] as one mesh; each face
  * split into n x n squares (n = 1: two triangles per face). */
-static inline int add_open_box(dem_domain *d, double L, double H, int n, int material)
+static inline dem_mesh_wall add_open_box(dem_domain *d, double L, double H, int n, dem_material material)
 {
     int64_t total_v = 0, total_t = 0;
     double *V = malloc((size_t)5 * (n + 1) * (n + 1) * 3 * sizeof(double));
@@ -77,7 +77,7 @@ static inline int add_open_box(dem_domain *d, double L, double H, int n, int mat
     }
     dem_mesh_def md = dem_default_mesh_def();
     md.material = material;
-    int mesh = -1;
+    dem_mesh_wall mesh = {-1};
     assert_ok(dem_mesh_wall_add(d, total_v, V, total_t, T, &md, &mesh));
     free(V);
     free(T);

@@ -30,12 +30,13 @@ static void test_every_block_comes_from_the_host_and_goes_back(void **st)
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
     assert_int_equal(dem_set_allocator(NULL), DEM_ERR_INVALID_ARGUMENT); /* a domain holds memory */
     dem_material_def m = dem_default_material_def();
-    int mat, wall;
+    dem_material mat;
+    dem_plane_wall wall;
     assert_int_equal(dem_material_create(d, &m, &mat), DEM_OK);
     dem_plane_wall_def w = dem_default_plane_wall_def();
     assert_int_equal(dem_plane_wall_add(d, &w, &wall), DEM_OK);
     double x[3 * 27], r[27];
-    int mats[27];
+    dem_material mats[27];
     for (int i = 0; i < 27; i++) {
         x[3 * i] = 0.002 + 0.003 * (i % 3);
         x[3 * i + 1] = 0.002 + 0.003 * (i / 3 % 3);

@@ -53,10 +53,10 @@ static void test_create_errors(void **st)
 static void test_misuse_leaves_domain_usable(void **st)
 {
     (void)st;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 1e7, 0.5, 0.5, &mat);
     dem_material_def m = dem_default_material_def();
-    int other;
+    dem_material other;
     m.youngs_modulus = 0;
     assert_status(dem_material_create(d, &m, &other), DEM_ERR_INVALID_ARGUMENT);
     assert_msg(d, "Young");
@@ -85,19 +85,19 @@ static void test_misuse_leaves_domain_usable(void **st)
     assert_status(dem_pair_set(d, mat, mat, &p), DEM_ERR_INVALID_ARGUMENT);
     assert_msg(d, "rolling friction");
     p = dem_default_pair_def();
-    assert_status(dem_pair_set(d, mat, 7, &p), DEM_ERR_UNKNOWN_MATERIAL);
+    assert_status(dem_pair_set(d, mat, (dem_material){7}, &p), DEM_ERR_UNKNOWN_MATERIAL);
     assert_msg(d, "unknown material");
     dem_pair_def got;
     assert_ok(dem_pair_get(d, mat, mat, &got));
     assert_true(got.restitution == 0.5 && got.friction == 0.5); /* unchanged */
 
     double pos[6] = {0.005, 0.005, 0.005, 0.005, 0.005, 0.0075}, rad[2] = {1e-3, 1e-3};
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     double nan_rad[2] = {1e-3, NAN}, neg_rad[2] = {1e-3, -1e-3};
     assert_status(dem_particles_add(d, 2, pos, nan_rad, mats, NULL, NULL, NULL), DEM_ERR_INVALID_ARGUMENT);
     assert_msg(d, "particle 1: radius");
     assert_status(dem_particles_add(d, 2, pos, neg_rad, mats, NULL, NULL, NULL), DEM_ERR_INVALID_ARGUMENT);
-    int bad_mats[2] = {mat, 3};
+    dem_material bad_mats[2] = {mat, {3}};
     assert_status(dem_particles_add(d, 2, pos, rad, bad_mats, NULL, NULL, NULL), DEM_ERR_UNKNOWN_MATERIAL);
     assert_msg(d, "particle 1: unknown material 3");
     assert_status(dem_particles_add(d, 2, NULL, rad, mats, NULL, NULL, NULL), DEM_ERR_NULL);
@@ -121,7 +121,7 @@ static void test_misuse_leaves_domain_usable(void **st)
     assert_status(dem_particles_remove(d, 1, &ghost), DEM_ERR_UNKNOWN_PARTICLE);
     dem_plane_wall_def w = dem_default_plane_wall_def();
     w.axis = 3;
-    int wall;
+    dem_plane_wall wall;
     assert_status(dem_plane_wall_add(d, &w, &wall), DEM_ERR_INVALID_ARGUMENT);
     w = dem_default_plane_wall_def();
     w.position = 0.0052; /* cuts particle 0 */
@@ -145,7 +145,7 @@ static void test_misuse_leaves_domain_usable(void **st)
 static void test_timestep_checks(void **st)
 {
     (void)st;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 1e7, 0.5, 0.5, &mat);
     double pos[3] = {0.005, 0.005, 0.005}, rad[1] = {1e-3};
     assert_ok(dem_particles_add(d, 1, pos, rad, &mat, NULL, NULL, NULL));
@@ -168,11 +168,11 @@ static void test_broken_runs_name_the_particle(void **st)
 {
     (void)st;
     /* escape through a closed face */
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 1e7, 0.5, 0.5, &mat);
     double pos[6] = {0.002, 0.005, 0.005, 0.008, 0.005, 0.005}, rad[2] = {1e-3, 1e-3};
     double vel[6] = {0, 0, 0, 0, 0, 50.0};
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, vel, NULL, NULL));
     assert_status(dem_domain_step(d, 1000), DEM_ERR_OUT_OF_BOUNDS);
     assert_msg(d, "particle id 1 left the domain");
@@ -209,14 +209,14 @@ static void test_broken_runs_name_the_particle(void **st)
 static void test_lifecycle_edges(void **st)
 {
     (void)st;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 1e7, 0.5, 0.5, &mat);
     assert_ok(dem_domain_step(d, 10)); /* no particles: time still advances */
     dem_diagnostics g;
     assert_ok(dem_domain_diagnostics(d, &g));
     assert_int_equal(g.step, 10);
     double pos[6] = {0.003, 0.005, 0.005, 0.007, 0.005, 0.005}, rad[2] = {1e-3, 1e-3}, v[6];
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     dem_particle_id ids[2], more[2];
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, ids));
     assert_ok(dem_domain_step(d, 10));
@@ -247,7 +247,7 @@ static void test_periodic_too_small(void **st)
     def.hi[0] = 0.005; /* < 3 x (2 R + skin) for R = 1 mm */
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
-    int mat;
+    dem_material mat;
     dem_material_def m = dem_default_material_def();
     assert_ok(dem_material_create(d, &m, &mat));
     double pos[3] = {0.0025, 0.05, 0.05}, rad[1] = {1e-3};
@@ -286,10 +286,10 @@ static void test_getters_check_capacity(void **st)
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
     dem_material_def m = dem_default_material_def();
-    int mat;
+    dem_material mat;
     assert_ok(dem_material_create(d, &m, &mat));
     double pos[6] = {0.02, 0.02, 0.02, 0.06, 0.06, 0.06}, rad[2] = {0.005, 0.005}, out[6] = {-1, -1, -1, -1, -1, -1};
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, NULL));
     assert_int_equal(dem_particles_get_positions(d, out, 1), DEM_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(dem_domain_last_error(d), "room for 1 particles, 2 to write"));

@@ -24,7 +24,7 @@ static dem_domain *make_gas(double e, double mu, double dt, int n_side)
     dem_domain *d;
     char msg[256];
     assert_int_equal(dem_domain_create(&def, &d, msg, sizeof msg), DEM_OK);
-    int mat;
+    dem_material mat;
     dem_material_def m = dem_default_material_def();
     m.youngs_modulus = E;
     assert_ok(dem_material_create(d, &m, &mat));
@@ -35,7 +35,7 @@ static dem_domain *make_gas(double e, double mu, double dt, int n_side)
     assert_ok(dem_pair_set(d, mat, mat, &p));
     int n = n_side * n_side * n_side;
     double pos[3 * 216], vel[3 * 216], rad[216], mean[3] = {0, 0, 0};
-    int mats[216];
+    dem_material mats[216];
     double h = L / n_side;
     for (int k = 0; k < n; k++) {
         int ix = k % n_side, iy = (k / n_side) % n_side, iz = k / (n_side * n_side);

@@ -15,7 +15,7 @@ static uint64_t run_bed(int threads, int periodic_x, int chunks)
     def.dt = 1e-5;
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
-    int mat;
+    dem_material mat;
     dem_material_def m = dem_default_material_def();
     assert_ok(dem_material_create(d, &m, &mat));
     dem_pair_def p = dem_default_pair_def();
@@ -27,12 +27,12 @@ static uint64_t run_bed(int threads, int periodic_x, int chunks)
         w.axis = walls[k][0];
         w.side = walls[k][1];
         w.position = w.side > 0 ? 0.0 : 0.02;
-        int id;
+        dem_plane_wall id;
         assert_ok(dem_plane_wall_add(d, &w, &id));
     }
     enum { NX = 9, NZ = 25, N = NX * NX * NZ };
     static double pos[3 * N], vel[3 * N], rad[N];
-    static int mats[N];
+    static dem_material mats[N];
     uint64_t s = 12345;
     for (int k = 0; k < N; k++) {
         int c[3] = {k % NX, (k / NX) % NX, k / (NX * NX)};

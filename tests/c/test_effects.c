@@ -34,7 +34,7 @@ static void test_registry(void **st)
 
 static double pair_force_z(double kc, double delta)
 {
-    int mat;
+    dem_material mat;
     dem_domain_def def = dem_default_domain_def();
     def.gravity[2] = 0;
     def.insert_overlap_ratio = 0.5; /* allow the deliberate overlap at insertion */
@@ -45,7 +45,7 @@ static double pair_force_z(double kc, double delta)
     assert_ok(dem_material_create(d, &m, &mat));
     if (kc > 0) assert_ok(dem_pair_set_effect(d, mat, mat, "cohesion_sjkr", &kc, 1));
     double pos[6] = {0.005, 0.005, 0.005, 0.005, 0.005, 0.005 + 2 * R - delta}, rad[2] = {R, R}, f[6];
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, NULL, NULL, NULL));
     assert_ok(dem_domain_step(d, 0)); /* forces of the current state */
     assert_ok(dem_particles_get_forces(d, f, dem_particle_count(d)));
@@ -67,7 +67,8 @@ static void test_sjkr_pair(void **st)
 static void test_sjkr_wall_and_switch_off(void **st)
 {
     (void)st;
-    int mat, wall;
+    dem_material mat;
+    dem_plane_wall wall;
     dem_domain_def def = dem_default_domain_def();
     def.gravity[2] = 0;
     def.insert_overlap_ratio = 0.5;
@@ -126,7 +127,8 @@ static void spin_down(double mu_t, double t_half, double t_end, double *w_half, 
     m.youngs_modulus = TE;
     m.poisson_ratio = TNU;
     m.density = TRHO;
-    int mat, wall;
+    dem_material mat;
+    dem_plane_wall wall;
     assert_ok(dem_material_create(d, &m, &mat));
     dem_pair_def p = dem_default_pair_def();
     p.rolling_friction = 0.0;

@@ -44,7 +44,7 @@ static impact make_impact(double e, double r_eff, double m_eff)
     m.youngs_modulus = E_AL;
     m.poisson_ratio = NU_AL;
     m.density = RHO;
-    int mat;
+    dem_material mat;
     assert_ok(dem_material_create(im.d, &m, &mat));
     dem_pair_def p = dem_default_pair_def();
     p.restitution = e;
@@ -63,9 +63,10 @@ static impact make_impact(double e, double r_eff, double m_eff)
 static void floor_impact(double e, const double v[3], const double w[3], double vel[3], double om[3])
 {
     impact im = make_impact(e, R, sphere_mass(RHO, R));
-    int wall, mat = 0;
+    dem_plane_wall wall;
+    dem_material mat = {0};
     dem_plane_wall_def pw = dem_default_plane_wall_def();
-    pw.material = 0;
+    pw.material = mat;
     assert_ok(dem_plane_wall_add(im.d, &pw, &wall));
     double pos[3] = {1.0, 1.0, R + 0.25 * VN * 200.0 * im.dt}, r = R;
     assert_ok(dem_particles_add(im.d, 1, pos, &r, &mat, v, w, NULL));
@@ -144,7 +145,7 @@ static void test_oblique_pair_impact_gross_sliding(void **st)
         const double tc = 200.0 * im.dt, half_offset = 0.5 * vt * (0.25 + 0.5) * tc;
         double pos[6] = {1.0 - half_offset, 1.0, 1.0 - R - gap / 2, 1.0 + half_offset, 1.0, 1.0 + R + gap / 2};
         double rad[2] = {R, R}, vel[6] = {vt / 2, 0, VN / 2, -vt / 2, 0, -VN / 2};
-        int mats[2] = {0, 0};
+        dem_material mats[2] = {{0}, {0}};
         assert_ok(dem_particles_add(im.d, 2, pos, rad, mats, vel, NULL, NULL));
         double om[6], x[6], f[6];
         for (int s = 0; s < im.steps; s++) { /* friction never along the slip, as on the floor */

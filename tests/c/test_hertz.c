@@ -54,7 +54,7 @@ static void test_sphere_sphere(void **state)
     const double v = 0.2; /* closing speed */
     double m = sphere_mass(RHO, R), m_eff = m / 2, r_eff = R / 2, es = e_star_same(E, NU);
     double tc = 2.94328 * hertz_max_overlap(m_eff, v, es, r_eff) / v, dt = tc / 4000;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, dt, E, 1.0, 0.0, &mat);
     assert_non_null(d);
     add_head_on_pair(d, mat, 0.005, R, 2e-7, v);
@@ -68,7 +68,7 @@ static void test_sphere_wall(void **state)
     const double v = 0.2;
     double m = sphere_mass(RHO, R), es = e_star_same(E, NU);
     double tc = 2.94328 * hertz_max_overlap(m, v, es, R) / v, dt = tc / 4000;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, dt, E, 1.0, 0.0, &mat);
     assert_non_null(d);
     add_sphere_over_floor(d, mat, 0.005, R, 1e-7, v);

@@ -14,11 +14,11 @@ typedef struct drop { double peak_force, contact_time, rebound; int max_contacts
  * (mesh_n = 0) or a grid mesh of mesh_n x mesh_n squares over [0, 0.01]^2. */
 static drop run_drop(int mesh_n, double x, double y, double e, double mu)
 {
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 2e-7, E, e, mu, &mat);
     assert_non_null(d);
     if (mesh_n == 0) {
-        int w;
+        dem_plane_wall w;
         dem_plane_wall_def pw = dem_default_plane_wall_def();
         pw.material = mat;
         assert_ok(dem_plane_wall_add(d, &pw, &w));
@@ -73,7 +73,7 @@ static void test_flat_mesh_equals_plane(void **state)
  * torque history are carried from triangle to triangle. */
 static void roll(int mesh, double out[6], int *max_contacts)
 {
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.04, 1e-6, E, 0.5, 0.5, &mat);
     assert_non_null(d);
     dem_pair_def p;
@@ -85,7 +85,7 @@ static void roll(int mesh, double out[6], int *max_contacts)
     if (mesh) {
         add_grid_mesh(d, 0, 0.04, 0, 0.04, 0, 32, 32, mat); /* 1.25 mm squares */
     } else {
-        int w;
+        dem_plane_wall w;
         dem_plane_wall_def pw = dem_default_plane_wall_def();
         pw.material = mat;
         assert_ok(dem_plane_wall_add(d, &pw, &w));
@@ -128,12 +128,12 @@ static void test_history_crosses_seams(void **state)
 static void test_moving_mesh_belt(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.04, 1e-6, E, 0.5, 0.3, &mat);
     assert_non_null(d);
     double g[3] = {0, 0, -9.81};
     assert_ok(dem_domain_set_gravity(d, g));
-    int m = add_grid_mesh(d, 0.0, 0.04, 0, 0.04, 0, 8, 8, mat);
+    dem_mesh_wall m = add_grid_mesh(d, 0.0, 0.04, 0, 0.04, 0, 8, 8, mat);
     double pos[3] = {0.02, 0.02, R - 5e-7};
     assert_ok(dem_particles_add(d, 1, pos, (double[]){R}, &mat, NULL, NULL, NULL));
     assert_ok(dem_domain_step(d, 5000)); /* come to rest */
@@ -153,9 +153,9 @@ static void test_moving_mesh_belt(void **state)
 static void test_rotation_pose(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.04, 1e-5, E, 0.5, 0.3, &mat);
-    int m = add_grid_mesh(d, 0.01, 0.03, 0.01, 0.03, 0.02, 2, 2, mat);
+    dem_mesh_wall m = add_grid_mesh(d, 0.01, 0.03, 0.01, 0.03, 0.02, 2, 2, mat);
     dem_mesh_info info;
     assert_ok(dem_mesh_wall_info(d, m, &info));
     const int64_t nv = info.vertex_count;
@@ -195,15 +195,15 @@ static void test_rotation_pose(void **state)
 static void test_mesh_candidates_find_every_contact(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.04, 1e-6, E, 0.5, 0.3, &mat);
     assert_non_null(d);
     const double z_plate = 0.001, z_lid = 0.035, u = 0.5;
-    int plate = add_grid_mesh(d, 0.0, 0.04, 0.0, 0.04, z_plate, 8, 8, mat);
+    dem_mesh_wall plate = add_grid_mesh(d, 0.0, 0.04, 0.0, 0.04, z_plate, 8, 8, mat);
     add_grid_mesh(d, 0.0, 0.04, 0.0, 0.04, z_lid, 4, 4, mat);
     enum { N = 48 };
     double pos[3 * N], vel[3 * N], rad[N];
-    int mats[N];
+    dem_material mats[N];
     uint64_t rng = 0x2545F4914F6CDD1DULL;
     for (int k = 0; k < N; k++) { /* 4 x 4 x 3 lattice of 3 mm, random velocities up to 0.3 m/s */
         pos[3 * k] = 0.0155 + 3e-3 * (k % 4);
@@ -240,7 +240,7 @@ static void test_mesh_candidates_find_every_contact(void **state)
 static void test_memory_counts_meshes(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.04, 1e-6, E, 0.5, 0.3, &mat);
     assert_non_null(d);
     double pos[3] = {0.02, 0.02, 0.02};

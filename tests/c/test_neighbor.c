@@ -40,7 +40,8 @@ static dem_domain *make_gas(void)
     def.dt = 2e-6;
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
-    int mat, wall;
+    dem_material mat;
+    dem_plane_wall wall;
     dem_material_def m = dem_default_material_def();
     m.youngs_modulus = 1e7;
     assert_ok(dem_material_create(d, &m, &mat));
@@ -53,7 +54,7 @@ static dem_domain *make_gas(void)
         assert_ok(dem_plane_wall_add(d, &w, &wall));
     }
     static double pos[3 * N], vel[3 * N], rad[N];
-    static int mats[N];
+    static dem_material mats[N];
     for (int k = 0; k < N; k++) { /* 8 x 8 x ~7 lattice of 3.6 mm, jittered */
         int c[3] = {k % 8, (k / 8) % 8, k / 64};
         for (int a = 0; a < 3; a++) {
@@ -130,13 +131,13 @@ static void test_lists_shrink_with_the_bed(void **st)
     def.dt = 2e-6;
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
-    int mat;
+    dem_material mat;
     dem_material_def m = dem_default_material_def();
     m.youngs_modulus = 1e7;
     assert_ok(dem_material_create(d, &m, &mat));
     enum { S = 12, M = S * S * S };
     static double pos[3 * M], rad[M];
-    static int mats[M];
+    static dem_material mats[M];
     for (int k = 0; k < M; k++) {
         int c[3] = {k % S, (k / S) % S, k / (S * S)};
         for (int a = 0; a < 3; a++) pos[3 * k + a] = 2e-3 + 2e-3 * c[a];

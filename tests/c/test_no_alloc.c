@@ -28,7 +28,9 @@ static void test_warm_steps_do_not_allocate(void **st)
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
     dem_material_def m = dem_default_material_def();
-    int mat, mesh, wall;
+    dem_material mat;
+    dem_mesh_wall mesh;
+    dem_plane_wall wall;
     assert_ok(dem_material_create(d, &m, &mat));
     dem_pair_def p = dem_default_pair_def();
     p.rolling_friction = 0.1;
@@ -43,7 +45,7 @@ static void test_warm_steps_do_not_allocate(void **st)
     assert_ok(dem_plane_wall_add(d, &pw, &wall));
     enum { NS = 8, NZ = 6 };
     double pos[3 * NS * NS * NZ], rad[NS * NS * NZ];
-    int mats[NS * NS * NZ];
+    dem_material mats[NS * NS * NZ];
     int n = 0;
     for (int k = 0; k < NZ; k++)
         for (int j = 0; j < NS; j++)

@@ -13,7 +13,7 @@ static void tmp_path(char *buf, size_t n, const char *name)
     snprintf(buf, n, "/tmp/dem_test_%d_%s", (int)getpid(), name);
 }
 
-static dem_domain *rich_run(int *lid)
+static dem_domain *rich_run(dem_mesh_wall *lid)
 {
     dem_domain_def def = dem_default_domain_def();
     for (int a = 0; a < 3; a++) {
@@ -25,7 +25,9 @@ static dem_domain *rich_run(int *lid)
     char msg[256];
     assert_ok(dem_domain_create(&def, &d, msg, sizeof msg));
     dem_material_def md = dem_default_material_def();
-    int ma, mb, mw;
+    dem_material ma;
+    dem_material mb;
+    dem_material mw;
     assert_ok(dem_material_create(d, &md, &ma));
     md.density = 4000;
     assert_ok(dem_material_create(d, &md, &mb));
@@ -33,18 +35,18 @@ static dem_domain *rich_run(int *lid)
     dem_pair_def p = dem_default_pair_def();
     p.rolling_friction = 0.1;
     for (int a = 0; a < 3; a++)
-        for (int b = a; b < 3; b++) assert_ok(dem_pair_set(d, a, b, &p));
+        for (int b = a; b < 3; b++) assert_ok(dem_pair_set(d, (dem_material){a}, (dem_material){b}, &p));
     double coh[1] = {2e3};
     assert_ok(dem_pair_set_effect(d, ma, mb, "cohesion_sjkr", coh, 1));
     dem_plane_wall_def floor = dem_default_plane_wall_def();
     floor.material = mw;
     floor.position = 0.0;
-    int fw;
+    dem_plane_wall fw;
     assert_ok(dem_plane_wall_add(d, &floor, &fw));
     add_open_box(d, 0.01, 0.02, 2, mw);
     uint64_t rng = 99;
     double pos[3 * 216], rad[216];
-    int mats[216];
+    dem_material mats[216];
     for (int k = 0; k < 216; k++) {
         pos[3 * k] = 0.0009 + 0.0016 * (k % 6);
         pos[3 * k + 1] = 0.0009 + 0.0016 * ((k / 6) % 6);
@@ -74,7 +76,7 @@ static dem_domain *rich_run(int *lid)
     return d;
 }
 
-static void finish(dem_domain *d, int lid, uint64_t *hash, double pose[12], double force[6])
+static void finish(dem_domain *d, dem_mesh_wall lid, uint64_t *hash, double pose[12], double force[6])
 {
     assert_ok(dem_domain_step(d, 2500));
     assert_ok(dem_domain_step(d, 1500));
@@ -88,7 +90,7 @@ static void test_restart_is_bit_exact(void **state)
     (void)state;
     char path[256];
     tmp_path(path, sizeof path, "restart.h5");
-    int lid;
+    dem_mesh_wall lid;
     dem_domain *a = rich_run(&lid);
     assert_ok(dem_snapshot_write(a, path));
     dem_profile pa0;
@@ -130,7 +132,7 @@ static void test_broken_snapshots(void **state)
     char path[256], bad[256], msg[256];
     tmp_path(path, sizeof path, "good.h5");
     tmp_path(bad, sizeof bad, "bad.h5");
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 5e6, 0.5, 0.5, &mat);
     add_sphere_over_floor(d, mat, 0.005, 1e-3, 1e-4, 0.1);
     assert_ok(dem_domain_step(d, 10));
@@ -179,14 +181,15 @@ static const unsigned char *px(const unsigned char *rgb, int w, int x, int y) { 
 static void test_render(void **state)
 {
     (void)state;
-    int m0, m1;
+    dem_material m0;
+    dem_material m1;
     dem_domain *d = make_domain(0.01, 1e-6, 5e6, 0.5, 0.5, &m0);
     dem_material_def md = dem_default_material_def();
     assert_ok(dem_material_create(d, &md, &m1));
     /* sphere 0 (material 0) behind sphere 1 (material 1) in the front view (camera at y = -inf) */
     double pos[9] = {0.003, 0.006, 0.005, 0.0035, 0.003, 0.005, 0.008, 0.005, 0.002};
     double rad[3] = {1e-3, 1e-3, 5e-4};
-    int mats[3] = {m0, m1, m0};
+    dem_material mats[3] = {m0, m1, m0};
     assert_ok(dem_particles_add(d, 3, pos, rad, mats, NULL, NULL, NULL));
     dem_render_def rd = dem_default_render_def();
     rd.width = 200;

@@ -11,7 +11,7 @@ static const double R = 1e-3, E = 1e9;
 /* Rebound speed / impact speed of a sphere on the floor (wall = 1) or of a head-on pair. */
 static double rebound(int wall, double e, double v, double dt)
 {
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.1, dt, E, e, 0.5, &mat);
     if (wall) add_sphere_over_floor(d, mat, 0.05, R, 1e-9, v);
     else add_head_on_pair(d, mat, 0.05, R, 2e-9, v);
@@ -47,7 +47,7 @@ static void test_delivered_restitution(void **state)
 static void test_correction_is_needed(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.1, 1e-7, E, 0.5, 0.5, &mat);
     double factor;
     assert_ok(dem_pair_damping_factor(d, mat, mat, &factor));

@@ -11,7 +11,7 @@
 
 static const double R = 1e-3, G = 9.81, MU = 0.5, DT = 2e-6;
 
-typedef struct rig { dem_domain *d; int mat; } rig;
+typedef struct rig { dem_domain *d; dem_material mat; } rig;
 
 static rig make_rig_model(double mu_r, dem_rolling_model model, double rolling_damping)
 {
@@ -34,7 +34,7 @@ static rig make_rig_model(double mu_r, dem_rolling_model model, double rolling_d
     assert_ok(dem_pair_set(r.d, r.mat, r.mat, &p));
     dem_plane_wall_def w = dem_default_plane_wall_def();
     w.material = r.mat;
-    int wall;
+    dem_plane_wall wall;
     assert_ok(dem_plane_wall_add(r.d, &w, &wall));
     /* start at the static overlap, then let the normal oscillation die out */
     double es = e_star_same(1e7, 0.25), mass = sphere_mass(2500, R);

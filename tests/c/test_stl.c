@@ -10,12 +10,12 @@
 
 #define CORPUS "tests/data/stl_corpus"
 
-static dem_domain *domain_with_material(int *mat)
+static dem_domain *domain_with_material(dem_material *mat)
 {
     return make_domain(2.0, 1e-5, 5e6, 0.5, 0.5, mat);
 }
 
-static dem_status load(dem_domain *d, const char *name, int mat, double scale, int *mesh)
+static dem_status load(dem_domain *d, const char *name, dem_material mat, double scale, dem_mesh_wall *mesh)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/%s", CORPUS, name);
@@ -28,7 +28,8 @@ static dem_status load(dem_domain *d, const char *name, int mat, double scale, i
 static void test_ascii_and_binary_cube(void **state)
 {
     (void)state;
-    int mat, m;
+    dem_mesh_wall m;
+    dem_material mat;
     dem_domain *d = domain_with_material(&mat);
     const char *names[3] = {"seed_ascii_cube.stl", "seed_binary_cube.stl", "binary_header_says_solid.stl"};
     for (int k = 0; k < 3; k++) {
@@ -47,23 +48,24 @@ static void test_ascii_and_binary_cube(void **state)
     dem_domain_destroy(d);
 }
 
-static void expect_error(dem_domain *d, int mat, const char *name, dem_status want, const char *words)
+static void expect_error(dem_domain *d, dem_material mat, const char *name, dem_status want, const char *words)
 {
-    int m = -7, before = dem_mesh_wall_count(d);
+    dem_mesh_wall m = {-7};
+    int before = dem_mesh_wall_count(d);
     dem_status s = load(d, name, mat, 1.0, &m);
     if (s != want || !strstr(dem_domain_last_error(d), words)) {
         print_error("%s: got %s '%s', want %s with '%s'\n", name, dem_status_name(s), dem_domain_last_error(d),
                     dem_status_name(want), words);
         fail();
     }
-    assert_int_equal(m, -7);
+    assert_int_equal(m.index, -7); /* the handle is untouched on failure */
     assert_int_equal(dem_mesh_wall_count(d), before);
 }
 
 static void test_malformed_files(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = domain_with_material(&mat);
     expect_error(d, mat, "no_such_file.stl", DEM_ERR_IO, "cannot open");
     expect_error(d, mat, "", DEM_ERR_IO, "cannot read"); /* the corpus directory itself */
@@ -79,9 +81,9 @@ static void test_malformed_files(void **state)
     expect_error(d, mat, "short_header.stl", DEM_ERR_FORMAT, "neither ASCII STL nor a binary STL");
     expect_error(d, mat, "all_degenerate.stl", DEM_ERR_FORMAT, "zero area");
     /* the domain is still usable */
-    int m;
+    dem_mesh_wall m;
     assert_ok(load(d, "seed_ascii_cube.stl", mat, 1.0, &m));
-    assert_int_equal(m, 0);
+    assert_int_equal(m.index, 0);
     assert_ok(dem_domain_step(d, 3));
     dem_domain_destroy(d);
 }
@@ -121,7 +123,8 @@ static void test_ascii_bom_and_upper_case(void **state)
 static void test_degenerate_triangles_skipped(void **state)
 {
     (void)state;
-    int mat, m;
+    dem_mesh_wall m;
+    dem_material mat;
     dem_domain *d = domain_with_material(&mat);
     /* a square of two triangles plus a sliver (collinear) and a collapsed one */
     double v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0, 0};
@@ -143,7 +146,7 @@ static void test_degenerate_triangles_skipped(void **state)
     md.scale = -1;
     assert_int_equal(dem_mesh_wall_add(d, 5, v, 2, t, &md, &m), DEM_ERR_INVALID_ARGUMENT);
     md.scale = 1;
-    md.material = 99;
+    md.material = (dem_material){99};
     assert_int_equal(dem_mesh_wall_add(d, 5, v, 2, t, &md, &m), DEM_ERR_UNKNOWN_MATERIAL);
     assert_int_equal(dem_mesh_wall_count(d), 1);
     dem_domain_destroy(d);
@@ -153,7 +156,8 @@ static void test_degenerate_triangles_skipped(void **state)
 static void test_mesh_particle_overlap(void **state)
 {
     (void)state;
-    int mat, m;
+    dem_material mat;
+    dem_mesh_wall m;
     dem_domain *d = domain_with_material(&mat);
     double p[3] = {0.5, 0.5, 0.5}, r = 0.01;
     assert_ok(dem_particles_add(d, 1, p, &r, &mat, NULL, NULL, NULL));
@@ -188,7 +192,9 @@ static unsigned char *read_all(const char *path, size_t *len)
 static void test_fuzz_corpus(void **state)
 {
     (void)state;
-    int mat, m, files = 0, ok = 0;
+    dem_material mat;
+    dem_mesh_wall m;
+    int files = 0, ok = 0;
     dem_domain *d = domain_with_material(&mat);
     DIR *dir = opendir(CORPUS);
     assert_non_null(dir);

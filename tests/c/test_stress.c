@@ -13,7 +13,7 @@ static const double R = 5e-4, L = 0.006, H = 0.02;
 /* Particles and lid of material *mat; the box of a second material whose friction with the
  * particles is wall_friction. */
 /* The L x L x H domain (dt 5 us) with one material *mat, restitution 0.2, friction 0.3. */
-static dem_domain *column_domain(int *mat)
+static dem_domain *column_domain(dem_material *mat)
 {
     dem_domain_def def = dem_default_domain_def();
     for (int a = 0; a < 3; a++) {
@@ -33,13 +33,13 @@ static dem_domain *column_domain(int *mat)
     return d;
 }
 
-static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_friction)
+static dem_domain *column(dem_mesh_wall *mesh_box, dem_material *mat, int64_t *n, double wall_friction)
 {
     dem_domain *d = column_domain(mat);
     dem_material_def md = dem_default_material_def();
     dem_pair_def p = dem_default_pair_def();
     p.restitution = 0.2;
-    int wall_mat;
+    dem_material wall_mat;
     assert_ok(dem_material_create(d, &md, &wall_mat));
     p.friction = wall_friction;
     assert_ok(dem_pair_set(d, *mat, wall_mat, &p));
@@ -47,7 +47,7 @@ static dem_domain *column(int *mesh_box, int *mat, int64_t *n, double wall_frict
     /* 5 x 5 x 8 simple-cubic lattice, 1.15 mm spacing, slightly jittered so it collapses */
     int64_t k = 0;
     double pos[3 * 200], rad[200];
-    int mats[200];
+    dem_material mats[200];
     uint64_t rng = 7;
     for (int z = 0; z < 8; z++)
         for (int y = 0; y < 5; y++)
@@ -76,7 +76,8 @@ static double total_weight(dem_domain *d, int64_t n)
 static void test_column_weight_on_walls(void **state)
 {
     (void)state;
-    int box, mat;
+    dem_mesh_wall box;
+    dem_material mat;
     int64_t n;
     dem_domain *d = column(&box, &mat, &n, 0.3);
     assert_ok(dem_domain_step(d, 40000)); /* 0.2 s: settled */
@@ -112,15 +113,16 @@ static void test_column_weight_on_walls(void **state)
 static void test_mean_wall_force(void **state)
 {
     (void)state;
-    int box, mat;
+    dem_mesh_wall box;
+    dem_material mat;
     int64_t n;
     dem_domain *d = column(&box, &mat, &n, 0.3);
     double f[3], t[3], sec = -1.0;
     assert_ok(dem_mesh_wall_reset_mean_force(d, box));
     assert_ok(dem_mesh_wall_mean_force(d, box, NULL, f, t, &sec));
     assert_true(sec == 0.0 && f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0); /* no step yet */
-    assert_int_equal(dem_mesh_wall_reset_mean_force(d, 7), DEM_ERR_UNKNOWN_WALL);
-    assert_int_equal(dem_mesh_wall_mean_force(d, -1, NULL, f, t, &sec), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_mesh_wall_reset_mean_force(d, (dem_mesh_wall){7}), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_mesh_wall_mean_force(d, (dem_mesh_wall){-1}, NULL, f, t, &sec), DEM_ERR_UNKNOWN_WALL);
     assert_ok(dem_domain_step(d, 20000)); /* falling and settling: a rattling force */
     const double p[3] = {0.003, 0.002, 0.001};
     double fs[3] = {0, 0, 0}, ts[3] = {0, 0, 0};
@@ -155,7 +157,9 @@ static void test_mean_wall_force(void **state)
 static void test_plane_wall_mean_force(void **state)
 {
     (void)state;
-    int mat, floor_wall, side[4];
+    dem_plane_wall floor_wall;
+    dem_material mat;
+    dem_plane_wall side[4];
     dem_domain *d = column_domain(&mat);
     dem_plane_wall_def w = dem_default_plane_wall_def(); /* floor z >= 0 */
     w.material = mat;
@@ -167,7 +171,7 @@ static void test_plane_wall_mean_force(void **state)
         assert_ok(dem_plane_wall_add(d, &w, &side[k]));
     }
     double pos[3 * 100], rad[100];
-    int mats[100];
+    dem_material mats[100];
     int64_t n = 0;
     uint64_t rng = 11;
     for (int z = 0; z < 4; z++)
@@ -184,8 +188,8 @@ static void test_plane_wall_mean_force(void **state)
     assert_ok(dem_plane_wall_reset_mean_force(d, floor_wall));
     assert_ok(dem_plane_wall_mean_force(d, floor_wall, f, &sec));
     assert_true(sec == 0.0 && f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0); /* no step yet */
-    assert_int_equal(dem_plane_wall_reset_mean_force(d, 9), DEM_ERR_UNKNOWN_WALL);
-    assert_int_equal(dem_plane_wall_mean_force(d, -1, f, &sec), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_plane_wall_reset_mean_force(d, (dem_plane_wall){9}), DEM_ERR_UNKNOWN_WALL);
+    assert_int_equal(dem_plane_wall_mean_force(d, (dem_plane_wall){-1}, f, &sec), DEM_ERR_UNKNOWN_WALL);
     const int steps = 3000; /* falling and landing: a rattling force */
     for (int s = 0; s < steps; s++) {
         assert_ok(dem_domain_step(d, 1));
@@ -213,7 +217,8 @@ static void test_plane_wall_mean_force(void **state)
 static void test_servo_lid_and_region_stress(void **state)
 {
     (void)state;
-    int box, mat;
+    dem_mesh_wall box;
+    dem_material mat;
     int64_t n;
     dem_domain *d = column(&box, &mat, &n, 0.0); /* frictionless sides: no Janssen arching */
     assert_ok(dem_domain_step(d, 30000));
@@ -221,7 +226,7 @@ static void test_servo_lid_and_region_stress(void **state)
     double x[3 * 200], zmax = 0.0;
     assert_ok(dem_particles_get_positions(d, x, dem_particle_count(d)));
     for (int64_t i = 0; i < n; i++) zmax = fmax(zmax, x[3 * i + 2]);
-    int lid = add_grid_mesh(d, 0, L, 0, L, zmax + R + 2e-4, 2, 2, mat);
+    dem_mesh_wall lid = add_grid_mesh(d, 0, L, 0, L, zmax + R + 2e-4, 2, 2, mat);
     const double sigma = 2000.0, area = L * L; /* 72 mN, ~30 x the column's weight */
     dem_servo_def sd = dem_default_servo_def();
     sd.target_stress = sigma;
@@ -285,7 +290,7 @@ static void test_servo_lid_and_region_stress(void **state)
 static void test_single_sphere_closed_form(void **state)
 {
     (void)state;
-    int mat;
+    dem_material mat;
     dem_domain *d = make_domain(0.01, 1e-6, 5e6, 0.5, 0.5, &mat);
     double g3[3] = {0, 0, -9.81};
     assert_ok(dem_domain_set_gravity(d, g3));

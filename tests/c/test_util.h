@@ -45,7 +45,7 @@
     } while (0)
 
 /* A closed box [0, L]^3, no gravity, one material with the given constants. */
-static inline dem_domain *make_domain(double box, double dt, double E, double e, double mu, int *material)
+static inline dem_domain *make_domain(double box, double dt, double E, double e, double mu, dem_material *material)
 {
     dem_domain_def def = dem_default_domain_def();
     for (int a = 0; a < 3; a++) {
@@ -81,9 +81,9 @@ static inline double test_urand(uint64_t *state)
 
 /* One sphere of radius r at (c, c, r + gap) falling at speed v onto a floor z >= 0 made
  * of the same material. */
-static inline void add_sphere_over_floor(dem_domain *d, int mat, double c, double r, double gap, double v)
+static inline void add_sphere_over_floor(dem_domain *d, dem_material mat, double c, double r, double gap, double v)
 {
-    int wall;
+    dem_plane_wall wall;
     dem_plane_wall_def w = dem_default_plane_wall_def();
     w.material = mat;
     assert_ok(dem_plane_wall_add(d, &w, &wall));
@@ -92,11 +92,11 @@ static inline void add_sphere_over_floor(dem_domain *d, int mat, double c, doubl
 }
 
 /* Two spheres of radius r on the z axis through (c, c, c), gap apart, closing at speed v. */
-static inline void add_head_on_pair(dem_domain *d, int mat, double c, double r, double gap, double v)
+static inline void add_head_on_pair(dem_domain *d, dem_material mat, double c, double r, double gap, double v)
 {
     double pos[6] = {c, c, c - r - gap / 2, c, c, c + r + gap / 2};
     double rad[2] = {r, r}, vel[6] = {0, 0, v / 2, 0, 0, -v / 2};
-    int mats[2] = {mat, mat};
+    dem_material mats[2] = {mat, mat};
     assert_ok(dem_particles_add(d, 2, pos, rad, mats, vel, NULL, NULL));
 }
 

@@ -99,3 +99,24 @@ def test_wheel_builds_libdem_from_sources_and_runs_outside_the_checkout(tmp_path
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr[-3000:]
     assert run.stdout.strip().startswith(str(target)), run.stdout
+
+
+@pytest.mark.parametrize("call, compiles", [
+    ("dem_mesh_wall_force(d, mesh, NULL, f, NULL)", True),
+    ("dem_mesh_wall_force(d, plane, NULL, f, NULL)", False),   # a plane wall where a mesh wall goes
+    ("dem_plane_wall_force(d, plane, f)", True),
+    ("dem_pair_set(d, mat, mat, NULL)", True),
+    ("dem_pair_set(d, mat, mesh, NULL)", False),               # a wall where a material goes
+    ("dem_pair_set(d, 0, 1, NULL)", False),                    # bare ints are not handles
+])
+def test_typed_handles_do_not_mix(tmp_path, call, compiles):
+    """Materials, plane walls and mesh walls are distinct handle types in the C API: misuse is a
+    compile error (gcc: incompatible type), right use compiles (docs/libdem.md, "Handles")."""
+    src = tmp_path / "h.c"
+    src.write_text('#include "dem/dem.h"\nvoid f_(dem_domain *d, dem_material mat, dem_plane_wall plane, '
+                   f'dem_mesh_wall mesh) {{ double f[3]; (void){call}; }}\n')
+    r = subprocess.run(["cc", "-std=c99", "-fsyntax-only", "-Werror", f"-I{ROOT / 'include'}", str(src)],
+                       capture_output=True, text=True)
+    assert (r.returncode == 0) == compiles, r.stderr
+    if not compiles:
+        assert "incompatible type" in r.stderr

@@ -11,7 +11,8 @@ static void test_engine_runs_and_the_left_out_calls_say_so(void **st)
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
     dem_material_def m = dem_default_material_def();
-    int mat, wall;
+    dem_material mat;
+    dem_plane_wall wall;
     assert_ok(dem_material_create(d, &m, &mat));
     dem_plane_wall_def pw = dem_default_plane_wall_def();
     assert_ok(dem_plane_wall_add(d, &pw, &wall));
