@@ -239,10 +239,13 @@ static int write_contacts(hid_t f, const dem_domain *d)
     const pair_list *pl = &d->pairs_cur;
     const wall_list *wl = &d->walls_cur;
     const tri_list *tl = &d->tris_cur;
+    contact_field pf[PAIR_FIELDS], wf[PLANE_FIELDS], mf[MESH_FIELDS];
+    const int pw = pair_fields(d, pf), ww = plane_fields(d, wf), mw = mesh_fields(d, mf);
+    const int width = pw > ww ? (pw > mw ? pw : mw) : (ww > mw ? ww : mw);
     int64_t cap = pl->count + wl->count + tl->count + 1;
     int64_t *ids = dem_malloc((size_t)cap * 2 * sizeof(int64_t));
     int32_t *iv = dem_malloc((size_t)cap * 3 * sizeof(int32_t));
-    double *h = dem_malloc((size_t)cap * 15 * sizeof(double));
+    double *h = dem_malloc((size_t)cap * (size_t)width * sizeof(double));
     int ok = ids && iv && h;
     int64_t r = 0;
     for (int64_t i = 0; ok && i < d->n; i++)
@@ -251,27 +254,24 @@ static int write_contacts(hid_t f, const dem_domain *d)
                 ids[2 * r] = d->id[i];
                 ids[2 * r + 1] = d->id[pl->j[k]];
                 iv[r] = pl->active[k];
-                memcpy(h + 12 * r, pl->hist + 6 * k, 6 * sizeof(double));
-                memcpy(h + 12 * r + 6, d->slot + 6 * k, 6 * sizeof(double));
+                pack_fields(pf, PAIR_FIELDS, k, h + (int64_t)pw * r);
                 r++;
             }
     ok = ok && w_dset(g, "pair_ids", H5T_NATIVE_INT64, (hsize_t)r, 2, ids) &&
          w_dset(g, "pair_active", H5T_NATIVE_INT32, (hsize_t)r, 0, iv) &&
-         w_dset(g, "pair_history_reaction", H5T_NATIVE_DOUBLE, (hsize_t)r, 12, h);
+         w_dset(g, "pair_history_reaction", H5T_NATIVE_DOUBLE, (hsize_t)r, (hsize_t)pw, h);
     r = 0;
     for (int64_t i = 0; ok && i < d->n; i++)
         for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++)
             if (nonzero(wl->xi + 3 * k, 3) || nonzero(wl->mr + 3 * k, 3) || nonzero(wl->force + 3 * k, 3)) {
                 ids[r] = d->id[i];
                 iv[r] = wl->wall[k];
-                memcpy(h + 9 * r, wl->xi + 3 * k, 3 * sizeof(double));
-                memcpy(h + 9 * r + 3, wl->mr + 3 * k, 3 * sizeof(double));
-                memcpy(h + 9 * r + 6, wl->force + 3 * k, 3 * sizeof(double));
+                pack_fields(wf, PLANE_FIELDS, k, h + (int64_t)ww * r);
                 r++;
             }
     ok = ok && w_dset(g, "plane_ids", H5T_NATIVE_INT64, (hsize_t)r, 0, ids) &&
          w_dset(g, "plane_wall", H5T_NATIVE_INT32, (hsize_t)r, 0, iv) &&
-         w_dset(g, "plane_history_force", H5T_NATIVE_DOUBLE, (hsize_t)r, 9, h);
+         w_dset(g, "plane_history_force", H5T_NATIVE_DOUBLE, (hsize_t)r, (hsize_t)ww, h);
     r = 0;
     for (int64_t i = 0; ok && i < d->n; i++)
         for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++)
@@ -280,15 +280,12 @@ static int write_contacts(hid_t f, const dem_domain *d)
                 iv[3 * r] = tl->mesh[k];
                 iv[3 * r + 1] = tl->tri[k];
                 iv[3 * r + 2] = tl->active[k];
-                memcpy(h + 15 * r, tl->hist + 6 * k, 6 * sizeof(double));
-                memcpy(h + 15 * r + 6, tl->force + 3 * k, 3 * sizeof(double));
-                memcpy(h + 15 * r + 9, tl->point + 3 * k, 3 * sizeof(double));
-                memcpy(h + 15 * r + 12, tl->normal + 3 * k, 3 * sizeof(double));
+                pack_fields(mf, MESH_FIELDS, k, h + (int64_t)mw * r);
                 r++;
             }
     ok = ok && w_dset(g, "mesh_ids", H5T_NATIVE_INT64, (hsize_t)r, 0, ids) &&
          w_dset(g, "mesh_mesh_triangle_active", H5T_NATIVE_INT32, (hsize_t)r, 3, iv) &&
-         w_dset(g, "mesh_history_force_point_normal", H5T_NATIVE_DOUBLE, (hsize_t)r, 15, h);
+         w_dset(g, "mesh_history_force_point_normal", H5T_NATIVE_DOUBLE, (hsize_t)r, (hsize_t)mw, h);
     dem_free(ids);
     dem_free(iv);
     dem_free(h);

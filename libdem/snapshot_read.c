@@ -450,10 +450,13 @@ static dem_status read_contacts(reader *r)
     if (g < 0) return bad(r, "group 'contacts' missing");
     dem_status st = DEM_OK;
     int64_t np = r_rows(g, "pair_ids"), nw = r_rows(g, "plane_ids"), nm = r_rows(g, "mesh_ids");
+    contact_field pf[PAIR_FIELDS], wf[PLANE_FIELDS], mf[MESH_FIELDS];
+    const int pw = pair_fields(d, pf), ww = plane_fields(d, wf), mw = mesh_fields(d, mf);
+    const int width = pw > ww ? (pw > mw ? pw : mw) : (ww > mw ? ww : mw);
     int64_t cap = (np > nw ? np : nw) > nm ? (np > nw ? np : nw) : nm;
     int64_t *ids = dem_malloc((size_t)(cap + 1) * 2 * sizeof(int64_t));
     int32_t *iv = dem_malloc((size_t)(cap + 1) * 3 * sizeof(int32_t));
-    double *h = dem_malloc((size_t)(cap + 1) * 15 * sizeof(double));
+    double *h = dem_malloc((size_t)(cap + 1) * (size_t)width * sizeof(double));
     if (np < 0 || nw < 0 || nm < 0 || !ids || !iv || !h) {
         st = bad(r, "contact tables missing");
         goto out;
@@ -461,7 +464,7 @@ static dem_status read_contacts(reader *r)
 #define ID_INDEX(id) (((id) >= 0 && (id) < d->next_id) ? d->index_of_id[(id)] : -1)
     pair_list *pl = &d->pairs_cur;
     if (!r_dset(g, "pair_ids", H5T_NATIVE_INT64, (hsize_t)np, 2, ids) || !r_dset(g, "pair_active", H5T_NATIVE_INT32, (hsize_t)np, 0, iv) ||
-        !r_dset(g, "pair_history_reaction", H5T_NATIVE_DOUBLE, (hsize_t)np, 12, h)) {
+        !r_dset(g, "pair_history_reaction", H5T_NATIVE_DOUBLE, (hsize_t)np, (hsize_t)pw, h)) {
         st = bad(r, "contacts/pair_*: wrong shape");
         goto out;
     }
@@ -479,12 +482,11 @@ static dem_status read_contacts(reader *r)
             goto out;
         }
         pl->active[k] = (uint8_t)(iv[q] != 0);
-        memcpy(pl->hist + 6 * k, h + 12 * q, 6 * sizeof(double));
-        memcpy(d->slot + 6 * k, h + 12 * q + 6, 6 * sizeof(double));
+        unpack_fields(pf, PAIR_FIELDS, k, h + (int64_t)pw * q);
     }
     const wall_list *wl = &d->walls_cur;
     if (!r_dset(g, "plane_ids", H5T_NATIVE_INT64, (hsize_t)nw, 0, ids) || !r_dset(g, "plane_wall", H5T_NATIVE_INT32, (hsize_t)nw, 0, iv) ||
-        !r_dset(g, "plane_history_force", H5T_NATIVE_DOUBLE, (hsize_t)nw, 9, h)) {
+        !r_dset(g, "plane_history_force", H5T_NATIVE_DOUBLE, (hsize_t)nw, (hsize_t)ww, h)) {
         st = bad(r, "contacts/plane_*: wrong shape");
         goto out;
     }
@@ -496,14 +498,12 @@ static dem_status read_contacts(reader *r)
             st = bad(r, "a plane-wall history has no candidate entry");
             goto out;
         }
-        memcpy(wl->xi + 3 * k, h + 9 * q, 3 * sizeof(double));
-        memcpy(wl->mr + 3 * k, h + 9 * q + 3, 3 * sizeof(double));
-        memcpy(wl->force + 3 * k, h + 9 * q + 6, 3 * sizeof(double));
+        unpack_fields(wf, PLANE_FIELDS, k, h + (int64_t)ww * q);
     }
     tri_list *tl = &d->tris_cur;
     if (!r_dset(g, "mesh_ids", H5T_NATIVE_INT64, (hsize_t)nm, 0, ids) ||
         !r_dset(g, "mesh_mesh_triangle_active", H5T_NATIVE_INT32, (hsize_t)nm, 3, iv) ||
-        !r_dset(g, "mesh_history_force_point_normal", H5T_NATIVE_DOUBLE, (hsize_t)nm, 15, h)) {
+        !r_dset(g, "mesh_history_force_point_normal", H5T_NATIVE_DOUBLE, (hsize_t)nm, (hsize_t)mw, h)) {
         st = bad(r, "contacts/mesh_*: wrong shape");
         goto out;
     }
@@ -516,10 +516,7 @@ static dem_status read_contacts(reader *r)
             goto out;
         }
         tl->active[k] = (uint8_t)(iv[3 * q + 2] != 0);
-        memcpy(tl->hist + 6 * k, h + 15 * q, 6 * sizeof(double));
-        memcpy(tl->force + 3 * k, h + 15 * q + 6, 3 * sizeof(double));
-        memcpy(tl->point + 3 * k, h + 15 * q + 9, 3 * sizeof(double));
-        memcpy(tl->normal + 3 * k, h + 15 * q + 12, 3 * sizeof(double));
+        unpack_fields(mf, MESH_FIELDS, k, h + (int64_t)mw * q);
     }
 #undef ID_INDEX
 out:
