@@ -39,7 +39,7 @@ def run(args):
         rng = np.random.default_rng(args.seed + k)
         truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, None if kind == "null" else kind)
         obs = synthetic.programme(setup.nets)
-        values = synthetic.rig_values(stores, truth.inputs(registry()), obs, seed=1000 + k, threads=1)
+        values = synthetic.rig_values(setup.stores, truth.inputs(setup.candidates), obs, seed=1000 + k, threads=1)
         row = {"kind": kind, "truth": {"theta": truth.theta, "effect": truth.effect, "parameter": truth.parameter,
                                         "strength": truth.strength},
                "rows": [{"rig": o.quantity.rig, "metric": o.quantity.metric, "conditions": o.conditions,

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation, Quantity, rig_metric
+from .quantities import Observation, rig_metric
 
 NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
          "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
@@ -35,7 +35,6 @@ def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6
         hi = min(n.hi[n.input_names.index("slot_width")] for n in hopper)
         slots = tuple(float(f"{b:.3g}") for b in np.linspace(lo, hi, 5)[1:4])
     for q in sorted(nets, key=lambda q: q.key):
-        net = nets[q]
         if q.rig == "ring-shear":
             for s in preshear:
                 if q.metric == "mu_ie_s":

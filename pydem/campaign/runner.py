@@ -239,7 +239,7 @@ class Campaign:
         lines.append("  ranges: " + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in spec.ranges.items()))
         if spec.fixed:
             lines.append("  fixed: " + ", ".join(f"{k}={v}" for k, v in spec.fixed.items()))
-        lines.append(f"  metrics: " + (", ".join(s.metric_names) or "none yet") +
+        lines.append("  metrics: " + (", ".join(s.metric_names) or "none yet") +
                      f" (rig protocol {s.rig_protocol}; this code: {RIGS[spec.rig][0].protocol})")
         for i in np.flatnonzero(s.status == FAILED)[:10]:
             lines.append(f"  failed #{i}: {s.errors[i]}")

@@ -8,7 +8,6 @@ import sys
 
 import numpy as np
 import pytest
-from scipy import stats
 
 from pydem.calibration import diagnose as dg
 from pydem.calibration.candidates import Candidate
