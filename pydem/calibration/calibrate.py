@@ -60,6 +60,22 @@ def residual_table(observations: list[Observation], model: Model, fit: Fit) -> l
     return rows
 
 
+WEAK_R2 = 0.3  # below: a surrogate says little about its parameters, and the report says so
+
+
+def weak_surrogates(observations: list[Observation], nets: dict) -> list[str]:
+    """Notes for the measured quantities whose surrogate explains little of its runs' variance."""
+    out = []
+    for q in dict.fromkeys(o.quantity for o in observations):
+        n = nets[q]
+        r2 = getattr(n, "r2", 1.0)
+        if r2 < WEAK_R2:
+            out.append(f"the surrogate of {q.key} explains little of its {getattr(n, 'runs', '?')} runs (hold-out R² "
+                       f"{r2:.2f}, RMSE {n.rmse:.3g}): what this quantity says about the parameters is mostly lost in "
+                       f"its uncertainty, and the posterior stays near the prior; more runs in its store are needed")
+    return out
+
+
 def row_notes(observations: list[Observation]) -> list[str]:
     """Notes on what the rows do not say or say beyond the surrogates: no uncertainty given, and
     conditions that no surrogate takes (compared at the campaign preset's value)."""
@@ -149,7 +165,7 @@ def calibrate(material: str, observations: list[Observation], nets: dict, ranges
                          f"box may be too small, or the model misses an effect (`pydem diagnose`)")
     if covered:
         notes.append("held at their neutral values: " + ", ".join(f"{c.name} ({c.parameter})" for c in covered))
-    notes += row_notes(observations)
+    notes += row_notes(observations) + weak_surrogates(observations, nets)
     for o in observations:
         if o.assumed:
             notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))

@@ -25,7 +25,7 @@ import numpy as np
 from scipy import stats
 
 from .candidates import Candidate
-from .calibrate import fit_base, fit_summary, residual_table, row_notes, window_screen
+from .calibrate import fit_base, fit_summary, residual_table, row_notes, weak_surrogates, window_screen
 from .fit import Fit, Model, minimise, posterior
 from .quantities import Observation
 
@@ -199,7 +199,7 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     inputs = set().union(*(set(nets[q].input_names) for q in used))
     covered = [c for c in candidates if c.parameter in inputs and c.parameter in ranges]
     not_covered = [c.name for c in candidates if c not in covered]
-    notes = row_notes(observations)
+    notes = row_notes(observations) + weak_surrogates(observations, nets)
     n = len(observations)
     base_model, base = fit_base(observations, nets, ranges, covered)
     testable = n > len(base_model.free)
