@@ -48,10 +48,20 @@ class Model:
         self.hi = np.array([ranges[n][1] for n in self.free])
         self.y = np.array([o.value for o in observations])
         self.sigma = np.array([n.row_sigma(o.uncertainty) for o, n in zip(observations, self.nets)])
-        self.cov = self._covariance()
-        # L^-1 once (rows are tens): whitening is then a small matrix product, not a solve per call
-        self._whiten = linalg.solve_triangular(np.linalg.cholesky(self.cov), np.eye(len(self.y)), lower=True)
+        self._whiten = None  # L^-1, made on first use (a model only asked for predictions needs no noise)
         self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
+
+    @property
+    def cov(self) -> np.ndarray:
+        return self._covariance()
+
+    @property
+    def whitener(self) -> np.ndarray:
+        """L^-1 (C = L L^T), computed once: rows are tens, so whitening is a small matrix product."""
+        if self._whiten is None:
+            self._whiten = linalg.solve_triangular(np.linalg.cholesky(self._covariance()), np.eye(len(self.y)),
+                                                   lower=True)
+        return self._whiten
 
     def _covariance(self) -> np.ndarray:
         """Rows' noise covariance: independent scatter plus the nets' errors, correlated over
@@ -72,11 +82,11 @@ class Model:
 
     def white(self, v: np.ndarray) -> np.ndarray:
         """L^-1 v for v (n,) or (n, k): residuals or Jacobian columns in units of the noise."""
-        return self._whiten @ v
+        return self.whitener @ v
 
     def white_rows(self, r: np.ndarray) -> np.ndarray:
         """Whitened residuals for r (m, n): one row per parameter point."""
-        return np.atleast_2d(r) @ self._whiten.T
+        return np.atleast_2d(r) @ self.whitener.T
 
     def _inputs_of(self, o: Observation, net, p: np.ndarray) -> np.ndarray:
         theta = dict(zip(self.free, p))
