@@ -47,7 +47,7 @@ class AorConfig:
     def preset(cls, name: str) -> "AorConfig":
         if name == "tiny":  # seconds: for tests
             return cls(particles=600, cylinder_radius=0.01, base_radius=0.035, lift_speed=0.1, max_time=3.0)
-        if name == "default":  # about two minutes on one core (1.8 min at friction 0.5, rolling 0.3)
+        if name == "default":  # 2-14 min on one core (median ~6 min over the campaign box; 1.8 min at mu 0.5, mu_r 0.3)
             return cls()
         if name == "paper":  # a lab-scale cylinder (50 mm) of 2 mm spheres
             return cls(particles=60000, diameter=2e-3, cylinder_radius=0.025, base_radius=0.1, lift_speed=0.01,
