@@ -241,7 +241,7 @@ static int write_contacts(hid_t f, const dem_domain *d)
     const tri_list *tl = &d->tris_cur;
     contact_field pf[PAIR_FIELDS], wf[PLANE_FIELDS], mf[MESH_FIELDS];
     const int pw = pair_fields(d, pf), ww = plane_fields(d, wf), mw = mesh_fields(d, mf);
-    const int width = pw > ww ? (pw > mw ? pw : mw) : (ww > mw ? ww : mw);
+    const int width = contact_row_width(pw, ww, mw);
     int64_t cap = pl->count + wl->count + tl->count + 1;
     int64_t *ids = dem_malloc((size_t)cap * 2 * sizeof(int64_t));
     int32_t *iv = dem_malloc((size_t)cap * 3 * sizeof(int32_t));

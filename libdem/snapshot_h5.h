@@ -46,6 +46,13 @@ static inline int mesh_fields(const dem_domain *d, contact_field f[MESH_FIELDS])
     return 6 + 3 + 3 + 3;
 }
 
+/* The widest row of the three layouts: one buffer serves them all. */
+static inline int contact_row_width(int pair_width, int plane_width, int mesh_width)
+{
+    const int w = pair_width > plane_width ? pair_width : plane_width;
+    return w > mesh_width ? w : mesh_width;
+}
+
 /* Entry k of the lists -> one file row, and back. */
 static inline void pack_fields(const contact_field *f, int n, int64_t k, double *row)
 {

@@ -452,7 +452,7 @@ static dem_status read_contacts(reader *r)
     int64_t np = r_rows(g, "pair_ids"), nw = r_rows(g, "plane_ids"), nm = r_rows(g, "mesh_ids");
     contact_field pf[PAIR_FIELDS], wf[PLANE_FIELDS], mf[MESH_FIELDS];
     const int pw = pair_fields(d, pf), ww = plane_fields(d, wf), mw = mesh_fields(d, mf);
-    const int width = pw > ww ? (pw > mw ? pw : mw) : (ww > mw ? ww : mw);
+    const int width = contact_row_width(pw, ww, mw);
     int64_t cap = (np > nw ? np : nw) > nm ? (np > nw ? np : nw) : nm;
     int64_t *ids = dem_malloc((size_t)(cap + 1) * 2 * sizeof(int64_t));
     int32_t *iv = dem_malloc((size_t)(cap + 1) * 3 * sizeof(int32_t));

@@ -77,14 +77,16 @@ def weak_surrogates(observations: list[Observation], nets: dict) -> list[str]:
 
 
 def row_notes(observations: list[Observation]) -> list[str]:
-    """Notes on what the rows do not say or say beyond the surrogates: no uncertainty given, and
-    conditions that no surrogate takes (compared at the campaign preset's value)."""
+    """Notes on what the rows do not say or say beyond the surrogates: no uncertainty given,
+    conditions not given (assumed at the preset's value), and conditions that no surrogate takes."""
     notes = []
     unstated = [o.label for o in observations if not o.uncertainty_given]
     if unstated:
         notes.append("no uncertainty given for " + ", ".join(unstated) + ": the rig's seed-to-seed scatter stands in "
                      "for the lab's repeat scatter (the likelihood's floor in any case)")
     for o in observations:
+        if o.assumed:
+            notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
         if o.ignored:
             notes.append(f"{o.label}: condition(s) " + ", ".join(f"{k}={v}" for k, v in o.ignored.items())
                          + " not taken by the surrogate: compared with the campaign preset as it is")
@@ -166,7 +168,4 @@ def calibrate(material: str, observations: list[Observation], nets: dict, ranges
     if covered:
         notes.append("held at their neutral values: " + ", ".join(f"{c.name} ({c.parameter})" for c in covered))
     notes += row_notes(observations) + weak_surrogates(observations, nets)
-    for o in observations:
-        if o.assumed:
-            notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
     return Calibration(material, observations, model, fit, screening, notes)

@@ -27,7 +27,7 @@ from scipy import stats
 from .candidates import Candidate
 from .calibrate import fit_base, fit_summary, residual_table, row_notes, weak_surrogates, window_screen
 from .fit import Fit, Model, minimise, posterior
-from .quantities import Observation
+from .quantities import Observation, test_conditions
 
 ALPHA = 0.01        # per-candidate significance (3 candidates: family-wise < 3 %)
 ACCEPT = 0.001      # a fit with chi^2 p-value below this is rejected
@@ -131,8 +131,7 @@ def _cosine(a: np.ndarray, b: np.ndarray) -> float:
 
 def _condition_key(o: Observation) -> str:
     """The condition group of an observation (the shear fraction is a point of one test, not a test)."""
-    items = [(k, v) for k, v in o.conditions.items() if k != "shear_fraction"]
-    return ", ".join(f"{k}={v:g}" for k, v in items) if items else ""
+    return ", ".join(f"{k}={v:g}" for k, v in test_conditions(o))
 
 
 def _loco(observations, nets, ranges, candidates, free: Candidate | None) -> float:
@@ -274,9 +273,6 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
             notes.append(f"base model: {name} sits at the edge of its campaign range "
                          f"[{p['range'][0]:g}, {p['range'][1]:g}] (estimate {p['estimate']:.4g}, 95 % interval "
                          f"{p['lo']:.4g}-{p['hi']:.4g})")
-    for o in observations:
-        if o.assumed:
-            notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
     final_model = after_model if after is not None else base_model
     window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,

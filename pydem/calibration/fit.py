@@ -28,7 +28,7 @@ from scipy import linalg, optimize, stats
 from scipy.stats import qmc
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation
+from .quantities import Observation, test_conditions
 
 # correlation length of a net's error over the conditions, in its scaled inputs (the range is 2):
 # a tanh MLP of <= 24 units trained on ~100 runs over 6-8 inputs does not resolve features finer
@@ -148,8 +148,7 @@ class Model:
 
 def _same_test(a: Observation, b: Observation) -> bool:
     """Two points of one test: the same conditions but the shear fraction (one specimen)."""
-    return a.conditions.keys() == b.conditions.keys() and "shear_fraction" in a.conditions and all(
-        a.conditions[k] == b.conditions[k] for k in a.conditions if k != "shear_fraction")
+    return "shear_fraction" in a.conditions and "shear_fraction" in b.conditions and test_conditions(a) == test_conditions(b)
 
 
 def _input_width(net, name: str) -> float:

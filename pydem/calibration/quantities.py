@@ -98,6 +98,22 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
     return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed, ignored=ignored)
 
 
+def fraction_columns(metric_names: list[str]) -> list[tuple[int, float]]:
+    """(column, shear fraction) of each per-shear-point metric (mu_ie_s_40 -> 0.4) of a store."""
+    out = []
+    for j, name in enumerate(metric_names):
+        hit = _FRACTION_METRIC.match(name)
+        if hit:
+            out.append((j, int(hit.group(1)) / 100.0))
+    return out
+
+
+def test_conditions(o: Observation) -> tuple:
+    """The conditions that make one test (one specimen, one run): all but the shear fraction,
+    which is a point within a test."""
+    return tuple(sorted((k, v) for k, v in o.conditions.items() if k != "shear_fraction"))
+
+
 def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
     """{Quantity: (input names, inputs, values)} over the store's finished runs. Ring-shear
     runs give one mu_ie_s row per shear point, the fraction as an extra input."""
@@ -109,12 +125,8 @@ def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.nda
         q = Quantity(rig, metric)
         if metric == "mu_ie_s":
             xs, ys = [], []
-            for j, mname in enumerate(store.metric_names):
-                hit = _FRACTION_METRIC.match(mname)
-                if not hit:
-                    continue
+            for j, frac in fraction_columns(store.metric_names):
                 ok = done & np.isfinite(store.values[:, j])
-                frac = int(hit.group(1)) / 100.0
                 xs.append(np.column_stack([store.params[ok], np.full(ok.sum(), frac)]))
                 ys.append(store.values[ok, j])
             if len(xs) > 1:

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .quantities import Quantity, training_tables
+from .quantities import Quantity, fraction_columns, training_tables
 
 NET_FORMAT = 1
 SIZES = (3, 6, 10, 16, 24)
@@ -120,7 +120,9 @@ def seed_scatter(store) -> dict[Quantity, float]:
     out = {}
     rig = store.spec.rig
     for metric in QUANTITIES[rig]:
-        names = [m for m in store.metric_names if m == metric or (metric == "mu_ie_s" and m.startswith("mu_ie_s_"))]
+        names = [metric] if metric in store.metric_names else []
+        if metric == "mu_ie_s":
+            names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
         ss, dof = 0.0, 0
         for m in names:
             _, means, counts, sd = store.point_table(m)
@@ -138,19 +140,16 @@ def test_correlation(store, net: QuantityNet) -> float:
     same run, over the store's finished runs (in-sample residuals: seed scatter and the net's
     misfit, which is what a measurement of the same test shares); clipped to [0, 0.95]; 0 for a
     quantity measured once per run."""
-    names = [m for m in store.metric_names if m.startswith(net.quantity.metric + "_")]
-    if "shear_fraction" not in net.input_names or len(names) < 2:
+    points = fraction_columns(store.metric_names)
+    if "shear_fraction" not in net.input_names or len(points) < 2:
         return 0.0
-    cols = []
-    for m in names:
-        frac = int(m.rsplit("_", 1)[1]) / 100.0
-        x = np.column_stack([store.params, np.full(len(store.params), frac)])
-        cols.append(store.values[:, store.metric_names.index(m)] - net(x))
-    r = np.array(cols).T[(store.status == 1) & np.all(np.isfinite(np.array(cols).T), axis=1)]
+    cols = np.array([store.values[:, j] - net(np.column_stack([store.params, np.full(len(store.params), frac)]))
+                     for j, frac in points]).T
+    r = cols[(store.status == 1) & np.all(np.isfinite(cols), axis=1)]
     if len(r) < 10:
         return 0.0
     c = np.corrcoef(r.T)
-    return float(np.clip(c[np.triu_indices(len(names), 1)].mean(), 0.0, 0.95))
+    return float(np.clip(c[np.triu_indices(len(points), 1)].mean(), 0.0, 0.95))
 
 
 def store_hash(store) -> str:
@@ -204,8 +203,10 @@ def load_or_train(store, say=print, retrain: bool = False) -> dict[Quantity, Qua
         for f in sorted(d.glob("*.npz")):
             with np.load(f) as a:
                 n = QuantityNet.from_arrays(a)
-                if "test_correlation" not in str(a["meta"]):  # cached before it was measured
-                    n.test_correlation = test_correlation(store, n)
+                stale = "test_correlation" not in str(a["meta"])  # cached before it was measured
+            if stale:
+                n.test_correlation = test_correlation(store, n)
+                np.savez(f, **n.to_arrays())
             nets[n.quantity] = n
         return nets
     say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs; cached in {d})")

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation, rig_metric
+from .quantities import Observation, rig_metric, test_conditions
 
 NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
          "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
@@ -134,7 +134,7 @@ def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generat
     out = np.zeros(len(obs))
     tests: dict = {}
     for i, o in enumerate(obs):
-        key = (o.quantity, tuple((k, v) for k, v in o.conditions.items() if k != "shear_fraction"))
+        key = (o.quantity, test_conditions(o))
         tests.setdefault(key, []).append(i)
     for (q, _), rows in tests.items():
         net = nets[q]
@@ -170,7 +170,7 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
     import time
     groups: dict = {}
     for i, o in enumerate(obs):
-        key = (o.quantity.rig, tuple(sorted((k, v) for k, v in o.conditions.items() if k != "shear_fraction")))
+        key = (o.quantity.rig, test_conditions(o))
         groups.setdefault(key, []).append(i)
     values = {}
     for g, ((rig, cond), idx) in enumerate(groups.items()):
