@@ -54,8 +54,9 @@ def rerun(args):
     the angle of repose's slow lift), same truths and seeds; the other rows are kept. The journal
     is rewritten whole after each set (resumable: a set already rerun at this preset is skipped)."""
     from pydem.calibration.candidates import registry
-    from pydem.campaign.runner import Campaign, resolved_config
-    stores = {st.spec.rig: st for st in (Campaign.open(p).store for p in args.stores)}
+    from pydem.calibration.setup import open_stores
+    from pydem.campaign.runner import resolved_config
+    stores = open_stores(args.stores)  # the stores' presets only: no nets needed
     journal = Path(args.journal)
     lines = [json.loads(x) for x in journal.read_text().splitlines()]
     for k, row in enumerate(lines):

@@ -32,7 +32,8 @@ class Setup:
     defaults: dict = field(default_factory=dict)  # condition -> preset value (rows that do not give it)
 
 
-def load_setup(paths, say=print, retrain: bool = False) -> Setup:
+def open_stores(paths) -> dict:
+    """{rig: CampaignStore}, one store per rig (two for one rig are refused)."""
     stores = {}
     for p in paths:
         st = Campaign.open(p).store
@@ -41,6 +42,11 @@ def load_setup(paths, say=print, retrain: bool = False) -> Setup:
         stores[st.spec.rig] = st
     if not stores:
         raise ValueError("no campaign stores given")
+    return stores
+
+
+def load_setup(paths, say=print, retrain: bool = False) -> Setup:
+    stores = open_stores(paths)
     physics = check_same_physics(stores.values(), "diagnose with")
     nets, ranges, defaults = {}, {}, {}
     for rig, st in stores.items():
