@@ -330,6 +330,7 @@ typedef struct dem_effect_contact {
     double wrel[3];     /* rad/s, angular velocity of i minus the partner's */
     double inv_inertia; /* 1/I_i + 1/I_j, 1/(kg m^2) (a wall: 1/I_i); spheres: I = 2/5 m r^2 */
     double tangential_stiffness; /* N/m, the Mindlin k_t = 8 G* sqrt(R* overlap) */
+    double vt[3];       /* m/s, tangential velocity of i relative to the partner at the contact */
 } dem_effect_contact;
 typedef struct dem_effect_param {
     const char *name, *unit;
@@ -341,6 +342,9 @@ typedef struct dem_effect_desc {
     dem_effect_param params[DEM_MAX_EFFECT_PARAMS];
     /* optional: returns the extra normal force (N, positive = repulsive) */
     double (*normal_force)(const dem_effect_contact *c, const double *params);
+    /* optional: adds a tangential force on i to force[3] (the partner gets the opposite; its
+     * torques follow from the lever arms as the friction's do) */
+    void (*tangential_force)(const dem_effect_contact *c, const double *params, double force[3]);
     /* optional: adds a torque on i to torque[3] (the partner gets the opposite) */
     void (*torque)(const dem_effect_contact *c, const double *params, double torque[3]);
 } dem_effect_desc;

@@ -6,27 +6,28 @@
  * law becomes one branch-free loop that the compiler vectorises (4 or 8 contacts per
  * instruction), and independent contacts fill each other's latency.
  *
- * The batch loop performs exactly the operations of contact_law() (contact_law.h) in the same
- * order, so results are bitwise those of the scalar law. Contacts it does not cover — rolling
- * models other than EPSD2 with mu_r > 0, or active effects — are flagged `scalar` and go
- * through contact_law() itself. */
+ * The batch loop calls the pieces of contact_law.h that contact_law() calls, in the same
+ * order, so results are bitwise those of the scalar law; it covers every rolling model.
+ * Contacts with active effects (function pointers, not vectorisable) are flagged `scalar` and
+ * go through contact_law() itself. */
 #ifndef DEM_PAIR_BATCH_H
 #define DEM_PAIR_BATCH_H
 
 #include "internal.h"
 
-#define DEM_PAIR_BATCH 64 /* contacts per batch: the batch is ~27 KB */
+#define DEM_PAIR_BATCH 64 /* contacts per batch: the batch is ~29 KB */
 
 /* Intermediates the law's stages pass on (pair_batch.c). */
 typedef struct pair_batch_scratch {
     double n[3][DEM_PAIR_BATCH], vt[3][DEM_PAIR_BATCH]; /* unit normal, tangential velocity */
     double ci[DEM_PAIR_BATCH], cj[DEM_PAIR_BATCH], r_eff[DEM_PAIR_BATCH];
-    double kt[DEM_PAIR_BATCH], gt[DEM_PAIR_BATCH], fn[DEM_PAIR_BATCH];
+    double kn[DEM_PAIR_BATCH], kt[DEM_PAIR_BATCH], gt[DEM_PAIR_BATCH], fn[DEM_PAIR_BATCH];
 } pair_batch_scratch;
 
 typedef struct pair_batch {
     int m;                              /* contacts in the batch */
     int any_scalar;
+    int rolling_case;                   /* set by dem_pair_batch_props (pair_batch.c) */
     const pair_props *uniform;          /* every contact of this pair type: the constants below unset */
     /* gathered: list entry, partner, geometry and kinematics (i minus j). A batch of wall
      * contacts (dem_wall_batch_law) instead holds in dx, dy, dz the unit normal (towards the
@@ -43,7 +44,8 @@ typedef struct pair_batch {
     double h[6][DEM_PAIR_BATCH];        /* spring histories in (xi 3, rolling torque 3), updated in place */
     /* pair constants, set by dem_pair_batch_props() unless the batch is uniform */
     double e_star[DEM_PAIR_BATCH], g_star[DEM_PAIR_BATCH], damping[DEM_PAIR_BATCH], st_ratio[DEM_PAIR_BATCH];
-    double friction[DEM_PAIR_BATCH], rolling[DEM_PAIR_BATCH]; /* rolling: mu_r of EPSD2 pairs, else 0 */
+    double friction[DEM_PAIR_BATCH], rolling[DEM_PAIR_BATCH], rolling_damping[DEM_PAIR_BATCH];
+    int8_t model[DEM_PAIR_BATCH];       /* dem_rolling_model */
     /* results: force on i, torques on i and on j, overlap */
     double force[3][DEM_PAIR_BATCH], ti[3][DEM_PAIR_BATCH], tj[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH];
     pair_batch_scratch s;
@@ -63,17 +65,15 @@ void dem_pair_batch_law(pair_batch *b, double dt);
  * caller sends contacts that take the scalar law through contact_law() instead. */
 void dem_wall_batch_law(pair_batch *b, double dt);
 
-/* Whether contacts of this pair type need contact_law() itself (effects, or rolling models
- * the batch loop does not cover). */
+/* Whether contacts of this pair type need contact_law() itself (effects). */
 int dem_takes_scalar_law(const pair_props *pp);
 
 /* The contact law of the scalar-flagged contacts, through contact_law(), from the histories
  * in the pair list (list_hist: 6 per entry, not yet updated); results replace the batch's. */
 void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist);
 
-/* The scalar law's input for contact q (geometry and kinematics as the sweep defines them),
- * with the lever arms ci, cj. */
+/* The scalar law's input for contact q (geometry and kinematics as the sweep defines them). */
 struct contact_in;
-void dem_pair_batch_contact_in(const pair_batch *b, int q, struct contact_in *in, double *ci, double *cj);
+void dem_pair_batch_contact_in(const pair_batch *b, int q, struct contact_in *in);
 
 #endif

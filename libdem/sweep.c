@@ -324,7 +324,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t r0 = use_split ? d->split[tid] : n * tid / nth, r1 = use_split ? d->split[tid + 1] : n * (tid + 1) / nth;
         sweep_result res;
         dem_sweep_result_init(&res);
-        pair_batch b; /* ~27 KB on the thread's stack */
+        pair_batch b; /* ~29 KB on the thread's stack */
         /* as much again for the mesh contacts, where there are any: the domain's, reserved by
          * the step (a second batch on the stack slowed the sweep without meshes by ~2 %) */
         const int any_mesh = d->tris_cur.count > 0;

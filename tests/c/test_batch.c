@@ -3,8 +3,8 @@
  * at their limit, several pair types in one batch or one type (the uniform loop) — must give
  * bit-identical forces, torques, overlaps and updated histories. Tolerance zero: the batch loop is the same sequence
  * of IEEE operations, and the engine's results (and the published benchmarks) rely on it.
- * Pairs the loop does not cover (CDT and EPSD rolling) go through contact_law() and must match
- * too. The wall form of the loop (mesh contacts) must match wall_contact_in() + contact_law()
+ * Every rolling model (CDT, EPSD with its dashpot, EPSD2), alone in a batch or mixed, must
+ * match too. The wall form of the loop (mesh contacts) must match wall_contact_in() + contact_law()
  * the same way. */
 #include "test_util.h"
 #include "contact_law.h"
@@ -70,13 +70,12 @@ static void random_contact(pair_batch *b, int q, const pair_props *pp, double *h
 static void reference(const pair_batch *b, int q, const double *h0, double dt, double *out, double *n)
 {
     contact_in in;
-    double ci, cj;
-    dem_pair_batch_contact_in(b, q, &in, &ci, &cj);
+    dem_pair_batch_contact_in(b, q, &in);
     double h[6];
     memcpy(h, h0, sizeof h);
     contact_out o;
     contact_law(b->pp[q], &in, dt, h, h + 3, &o);
-    contact_torques(&o, ci, cj, out + 3, out + 6);
+    contact_torques(&o, in.ci, in.cj, out + 3, out + 6);
     for (int a = 0; a < 3; a++) {
         out[a] = o.force[a];
         n[a] = in.n[a];
@@ -101,6 +100,7 @@ static void check_batch(const pair_props *types, int n_types, int m, int *slides
     const int told = n_types == 1 && m % 2;
     dem_pair_batch_props(&b, told ? types : NULL);
     assert_true((b.uniform != NULL) == (n_types == 1 || m == 1));
+    assert_int_equal(b.any_scalar, 0); /* no effects: every rolling model stays in the batch */
     dem_pair_batch_law(&b, dt);
     if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt, list_hist);
     for (int q = 0; q < m; q++) {
@@ -144,7 +144,7 @@ static void test_batch_equals_scalar_law(void **state)
     assert_true(limits > 50);  /* and the rolling limit */
 }
 
-static void test_other_rolling_models_take_the_scalar_law(void **state)
+static void test_every_rolling_model_in_the_batch(void **state)
 {
     (void)state;
     const pair_props types[3] = {props(0.5, 0.2, DEM_ROLLING_CDT, 3e6), props(0.4, 0.1, DEM_ROLLING_EPSD, 3e6),
@@ -213,11 +213,13 @@ static void check_wall_batch(const pair_props *types, int n_types, int m, int *s
 static void test_wall_batch_equals_scalar_law(void **state)
 {
     (void)state;
-    const pair_props types[3] = {props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6),
-                                 props(0.8, 0.05, DEM_ROLLING_EPSD2, 1e8)};
+    const pair_props types[5] = {props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6),
+                                 props(0.8, 0.05, DEM_ROLLING_EPSD2, 1e8), props(0.4, 0.2, DEM_ROLLING_CDT, 3e6),
+                                 props(0.6, 0.1, DEM_ROLLING_EPSD, 3e6)};
     int slides = 0;
     for (int round = 0; round < 30; round++) check_wall_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides);
-    for (int round = 0; round < 30; round++) check_wall_batch(types + round % 3, 1, DEM_PAIR_BATCH, &slides);
+    for (int round = 0; round < 30; round++) check_wall_batch(types + round % 5, 1, DEM_PAIR_BATCH, &slides);
+    for (int round = 0; round < 10; round++) check_wall_batch(types, 5, DEM_PAIR_BATCH, &slides); /* models mixed */
     assert_true(slides > 50);
 }
 
@@ -225,7 +227,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_batch_equals_scalar_law),
-        cmocka_unit_test(test_other_rolling_models_take_the_scalar_law),
+        cmocka_unit_test(test_every_rolling_model_in_the_batch),
         cmocka_unit_test(test_wall_batch_equals_scalar_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

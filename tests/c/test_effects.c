@@ -4,8 +4,11 @@
  * arithmetic: tolerance 1e-12.
  * Twisting resistance: a sphere resting on a plane and spinning about the vertical slows at the
  * constant torque mu_t R m g (w = w0 - (5/2) mu_t g t / R) until the viscous branch of the law
- * takes over, then creeps to rest exponentially without turning back. */
+ * takes over, then creeps to rest exponentially without turning back.
+ * A tangential-force kernel (no member uses one yet): its force adds to the contact's force
+ * and its torques follow from the lever arms, as the friction's do (arithmetic: 1e-12). */
 #include "test_util.h"
+#include "contact_law.h"
 
 static const double R = 1e-3, E = 1e7, NU = 0.25, KC = 5e4;
 
@@ -178,6 +181,42 @@ static void test_twisting_spin_down(void **st)
     assert_close(w_end, W0, 1e-12, 0);
 }
 
+/* A made-up effect with a tangential kernel: a viscous drag -c vt. */
+static void drag(const dem_effect_contact *c, const double *params, double force[3])
+{
+    for (int a = 0; a < 3; a++) force[a] -= params[0] * c->vt[a];
+}
+
+static void test_tangential_kernel(void **st)
+{
+    (void)st;
+    const dem_effect_desc desc = {.name = "drag", .n_params = 1, .tangential_force = drag};
+    /* two spheres touching along z, i above j, sliding in x and spinning: the contact's input */
+    const double dv[3] = {0.02, -0.01, 0.0}, wi[3] = {1.0, 2.0, 0.5}, wj[3] = {0.0, -1.0, 0.0};
+    contact_in c;
+    pair_geometry(&c, 0.0, 0.0, 1.99e-3, 1.99e-3 * 1.99e-3, R, R, 1.0 / 1e-5, 1.0 / 1e-5, dv, wi, wj);
+    double vn = c.vc[0] * c.n[0] + c.vc[1] * c.n[1] + c.vc[2] * c.n[2], vt[3];
+    tangential_velocity(&c, vn, vt);
+    dem_effect_contact ec = {.normal_force = 1.0};
+    for (int a = 0; a < 3; a++) ec.vt[a] = vt[a];
+    const double cdrag = 3.0, ft0[3] = {0.1, 0.2, 0.0};
+    double ft[3] = {ft0[0], ft0[1], ft0[2]}, mr[3] = {0.0, 0.0, 0.0}, fn = 1.0;
+    effect_apply(&desc, &cdrag, &ec, &fn, ft, mr);
+    assert_true(fn == 1.0 && mr[0] == 0.0 && mr[1] == 0.0 && mr[2] == 0.0); /* only the force moved */
+    double cross[3], ti[3], tj[3];
+    tangential_cross(c.n, ft, cross);
+    torques_from(cross, mr, c.ci, c.cj, ti, tj);
+    for (int a = 0; a < 3; a++) {
+        const double f = ft0[a] - cdrag * vt[a];
+        assert_true(fabs(ft[a] - f) <= 1e-12 * (fabs(f) + 1e-3));
+    }
+    /* torque on i: -(R - delta/2) n x F_t with n = +z: (F_y, -F_x, 0) times the lever arm */
+    const double arm = R - 0.5 * (2 * R - 1.99e-3);
+    assert_true(fabs(ti[0] - arm * ft[1]) <= 1e-12 && fabs(ti[1] + arm * ft[0]) <= 1e-12 && ti[2] == 0.0);
+    for (int a = 0; a < 3; a++) assert_true(fabs(tj[a] - ti[a]) <= 1e-15); /* equal spheres: equal arms */
+    assert_true(fabs(vt[2]) <= 1e-15 && fabs(vt[0]) > 0.0); /* the kernel saw the tangential velocity */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -185,6 +224,7 @@ int main(void)
         cmocka_unit_test(test_sjkr_pair),
         cmocka_unit_test(test_sjkr_wall_and_switch_off),
         cmocka_unit_test(test_twisting_spin_down),
+        cmocka_unit_test(test_tangential_kernel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
