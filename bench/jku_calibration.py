@@ -1,14 +1,16 @@
 """Seed 000's own materials (JKU Linz angles of repose, data/measurements/jku_angle_of_repose.csv)
-calibrated on the shipped default-preset stores: for each of the eight materials the base
-model's posterior (friction, rolling friction, restitution; the candidate effects at neutral),
-the angle the surrogate gives at the estimate, whether the estimate sits on a range edge, and
-seed 000's ±5 % window. One measured angle per material cannot pin three parameters: the
-posterior is a ridge, and the table says how narrow each parameter still gets.
+calibrated on an angle-of-repose store (default: data/campaigns/aor_jku.h5, the non-cohesive
+three-parameter campaign at the slow-lift default preset): for each of the eight materials the
+base model's posterior (friction, rolling friction, restitution), the angle the surrogate gives
+at the estimate, whether the estimate sits on a range edge, and seed 000's ±5 % window. One
+measured angle per material cannot pin three parameters: the posterior is a ridge, and the
+table says how narrow each parameter still gets.
 
-    .venv/bin/python bench/jku_calibration.py     # -> bench/results/jku_calibration.{json,md}
+    .venv/bin/python bench/jku_calibration.py [--stores S ...]  # -> bench/results/jku_calibration.{json,md}
 """
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from pathlib import Path
@@ -17,14 +19,19 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pydem.calibration.calibrate import calibrate  # noqa: E402
-from pydem.calibration.setup import DEFAULT_STORES, load_setup, observations_from_file  # noqa: E402
+from pydem.calibration.setup import load_setup, observations_from_file  # noqa: E402
 from pydem.measurements import load as load_measurements  # noqa: E402
 
 MEAS = ROOT / "data/measurements/jku_angle_of_repose.csv"
+JKU_STORES = ("data/campaigns/aor_jku.h5",)
 
 
 def main() -> int:
-    setup = load_setup([ROOT / s for s in DEFAULT_STORES], say=lambda *_: None)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--stores", nargs="+", default=list(JKU_STORES), help="campaign stores (default: %(default)s)")
+    stores = ap.parse_args().stores
+    setup = load_setup([ROOT / s for s in stores], say=lambda *_: None)
+    fits = {q.key: (n.r2, n.rmse) for q, n in setup.nets.items()}
     materials = sorted({m.material for m in load_measurements(MEAS, None)})
     rows = []
     for name in materials:
@@ -41,8 +48,10 @@ def main() -> int:
               + "  ".join(f"{k} {p['mean']:.3f} [{p['lo']:.3f}, {p['hi']:.3f}]{'*' if p['at_edge'] else ''}"
                           for k, p in post.items()), flush=True)
     out = ROOT / "bench/results/jku_calibration.json"
-    out.write_text(json.dumps({"stores": [str(s) for s in DEFAULT_STORES], "materials": rows}, indent=1))
-    lines = ["| material | measured | surrogate at estimate | ±5 % admissible of 2^18 | friction mean [95 %] | "
+    out.write_text(json.dumps({"stores": list(stores), "surrogates": fits, "materials": rows}, indent=1))
+    lines = [f"Stores: {', '.join(stores)}; surrogates (hold-out R², RMSE): "
+             + "; ".join(f"{k} {r2:.2f}, {rmse:.3g}" for k, (r2, rmse) in fits.items()), "",
+             "| material | measured | surrogate at estimate | ±5 % admissible of 2^18 | friction mean [95 %] | "
              "rolling friction mean [95 %] | restitution mean [95 %] |", "|---|---|---|---|---|---|---|"]
     for r in rows:
         p = r["parameters"]

@@ -221,7 +221,10 @@ def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edg
     lo, hi = fit.lo, fit.hi
     width = hi - lo
     J = model.white(model.jacobian(fit.best))
-    info = J.T @ J + np.diag(1e-9 / width ** 2)
+    # plus a precision of one box width per parameter: where the data leave a direction free
+    # (one angle, three parameters) J^T J is singular and its inverse not a covariance; the
+    # proposal is then as wide as the box there, and the weights correct for it either way
+    info = J.T @ J + np.diag(1.0 / width ** 2)
     cov = 4.0 * np.linalg.inv(info)
     half = samples // 2
     uni = qmc.scale(qmc.Sobol(k, scramble=True, seed=seed).random(half), lo, hi)

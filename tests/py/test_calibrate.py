@@ -64,6 +64,26 @@ def test_posterior_covers_the_truth_and_the_native_window_is_numpy_s(tiny, tmp_p
     assert np.allclose(w["points"], pts[keep], rtol=0, atol=0)
 
 
+def test_one_angle_for_three_parameters_gives_a_ridge_not_an_error(tiny):
+    """One measured angle cannot pin three parameters: the data's information matrix is singular
+    (rank 1). The posterior must still come out — the unconstrained directions as wide as the
+    prior — instead of failing in the proposal's Cholesky factor (as it did for the JKU angles)."""
+    from pydem.calibration.fit import Model, minimise, posterior
+    from pydem.calibration.quantities import Observation
+    q = next(q for q in tiny.nets if q.rig == "aor" and q.metric == "angle_of_repose")
+    obs = [Observation(q, {}, 30.0, 0.5, "angle")]
+    model = Model(obs, tiny.nets, tiny.ranges, tiny.candidates)
+    fit = minimise(model, starts=256)
+    # the angle's sensitivities as the JKU store had them: one row, every entry non-zero
+    model.jacobian = lambda p: np.array([[1.0711151791612545, 11.444224318427562, -3.6374110231928567]])
+    model.white = lambda v: v  # (already whitened)
+    post = posterior(model, fit, samples=2 ** 12)
+    widths = {n: (p["hi"] - p["lo"]) / (hi - lo) for n, p, lo, hi in
+              zip(fit.names, post["parameters"].values(), model.lo, model.hi)}
+    assert post["ess"] > 50
+    assert max(widths.values()) > 0.6, widths  # some direction stays nearly as wide as the box
+
+
 def test_calibrate_command_writes_report_nets_and_window(tiny, tmp_path):
     from pydem.calibration.setup import TINY_STORES
     f, _, _ = pseudo_measurements(tmp_path, tiny, {"friction": 0.4, "rolling_friction": 0.2, "restitution": 0.6})
