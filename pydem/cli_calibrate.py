@@ -56,8 +56,7 @@ def main(args) -> int:
     say(f"  {len(files)} surrogates exported to {out / 'nets'} (libdem weights files, C99 sources in nets/c)")
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
-               "stores": {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem")}
-                          for r, s in setup.stores.items()}, "window": args.window, "samples": args.samples}
+               "stores": setup.store_provenance(), "window": args.window, "samples": args.samples}
     if args.confirm:
         from .calibration.confirm import confirm
         from .cli import ProgressLine

@@ -15,7 +15,7 @@ def add_common(p, out: str, threads: int):
     p.add_argument("measurements", help="measurement file (docs/measurements.md)")
     p.add_argument("--material", required=True)
     p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
-                   help="campaign stores, one per rig (default: the shipped diagnosis stores)")
+                   help="campaign stores: one per rig, and others of a rig pooled into its surrogates (default: the shipped diagnosis stores)")
     p.add_argument("--out", default=out)
     p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
     p.add_argument("--threads", type=int, default=threads, help=f"threads of the confirming runs (default {threads})")
@@ -65,8 +65,7 @@ def main(args) -> int:
     d.notes += [f"left out: {line}" for line in skipped]
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
-               "stores": {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem")}
-                          for r, s in setup.stores.items()}, "libdem_of_stores": setup.physics}
+               "stores": setup.store_provenance(), "libdem_of_stores": setup.physics}
     if args.confirm:
         from .calibration.confirm import confirm
         from .cli import ProgressLine

@@ -114,31 +114,40 @@ def test_conditions(o: Observation) -> tuple:
     return tuple(sorted((k, v) for k, v in o.conditions.items() if k != "shear_fraction"))
 
 
-def training_tables(store) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
-    """{Quantity: (input names, inputs, values)} over the store's finished runs. Ring-shear
-    runs give one mu_ie_s row per shear point, the fraction as an extra input."""
+def training_tables(store, pooled=()) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
+    """{Quantity: (input names, inputs, values)} over the store's finished runs and those of the
+    stores pooled with it (pooled_runs.py: their runs mapped into this store's parameter
+    columns). Ring-shear runs give one mu_ie_s row per shear point, the fraction as an extra
+    input."""
+    from .pooled_runs import pooled_params
     rig = store.spec.rig
     names = list(store.spec.names)
-    done = store.status == 1
+    sources = [(store, store.params)] + [(o, pooled_params(store, o)) for o in pooled]
     out = {}
     for metric in QUANTITIES[rig]:
         q = Quantity(rig, metric)
-        if metric == "mu_ie_s":
-            xs, ys = [], []
-            for j, frac in fraction_columns(store.metric_names):
-                ok = done & np.isfinite(store.values[:, j])
-                xs.append(np.column_stack([store.params[ok], np.full(ok.sum(), frac)]))
-                ys.append(store.values[ok, j])
-            if len(xs) > 1:
-                out[q] = (names + ["shear_fraction"], np.vstack(xs), np.concatenate(ys))
-            elif xs:  # one shear point: the fraction is a fixed condition of the store, not an input
-                out[q] = (names, xs[0][:, :-1], ys[0])
+        xs, ys, fractions = [], [], set()
+        for st, params in sources:
+            done = st.status == 1
+            if metric == "mu_ie_s":
+                for j, frac in fraction_columns(st.metric_names):
+                    ok = done & np.isfinite(st.values[:, j])
+                    xs.append(np.column_stack([params[ok], np.full(ok.sum(), frac)]))
+                    ys.append(st.values[ok, j])
+                    fractions.add(frac)
+            elif metric in st.metric_names:
+                j = st.metric_names.index(metric)
+                ok = done & np.isfinite(st.values[:, j])
+                xs.append(params[ok])
+                ys.append(st.values[ok, j])
+        if not xs:
             continue
-        if metric not in store.metric_names:
-            continue
-        j = store.metric_names.index(metric)
-        ok = done & np.isfinite(store.values[:, j])
-        out[q] = (names, store.params[ok], store.values[ok, j])
+        if metric != "mu_ie_s":
+            out[q] = (names, np.vstack(xs), np.concatenate(ys))
+        elif len(fractions) > 1:
+            out[q] = (names + ["shear_fraction"], np.vstack(xs), np.concatenate(ys))
+        else:  # one shear point: the fraction is a fixed condition of the store, not an input
+            out[q] = (names, np.vstack(xs)[:, :-1], np.concatenate(ys))
     return out
 
 

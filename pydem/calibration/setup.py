@@ -11,15 +11,19 @@ from ..campaign import Campaign
 from ..campaign.store import check_same_physics
 from ..measurements import load as load_measurements
 from .candidates import BASE_PARAMETERS, Candidate, registry
+from .pooled_runs import check_poolable
 from .quantities import Observation, ObservationError, observation, preset_conditions
 from .surrogates import load_or_train
 
-# the shipped diagnosis stores, one per rig: at the rigs' tiny presets (the CI's, quick to remake)
-# and at their default presets (the ones measurements made with the default rigs are compared with)
+# the shipped diagnosis stores, one per rig (and stores pooled into one, open_store_groups): at the
+# rigs' tiny presets (the CI's, quick to remake) and at their default presets (the ones
+# measurements made with the default rigs are compared with)
 TINY_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_aor_tiny.h5",
                "data/campaigns/diag_hopper_tiny.h5")
+# (aor_jku.h5: seed 000's three-parameter angle-of-repose campaign, pooled into the angle-of-repose
+# surrogates: its runs are points of the diagnosis box, pooled_runs.py)
 DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/diag_aor_default.h5",
-                  "data/campaigns/diag_hopper_default.h5")
+                  "data/campaigns/aor_jku.h5", "data/campaigns/diag_hopper_default.h5")
 
 
 @dataclass
@@ -30,37 +34,67 @@ class Setup:
     candidates: list[Candidate]
     physics: str            # libdem major.minor of the runs
     defaults: dict = field(default_factory=dict)  # condition -> preset value (rows that do not give it)
+    pooled: dict = field(default_factory=dict)    # rig -> the stores pooled into its surrogates
+
+    def store_provenance(self) -> dict:
+        """{rig: path, commit and libdem of its store, and the paths of the stores pooled in}, for reports."""
+        return {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem"),
+                    "pooled": [str(o.path) for o in self.pooled.get(r, [])]} for r, s in self.stores.items()}
+
+
+def _relative_volume(store, stores) -> float:
+    """The store's box volume relative to the union of the stores' ranges, parameter by parameter."""
+    vol = 1.0
+    for name, (lo, hi) in store.spec.ranges.items():
+        los = [st.spec.ranges[name][0] for st in stores if name in st.spec.ranges]
+        his = [st.spec.ranges[name][1] for st in stores if name in st.spec.ranges]
+        vol *= (hi - lo) / max(max(his) - min(los), 1e-300)
+    return vol
+
+
+def open_store_groups(paths) -> dict:
+    """{rig: (main store, [stores pooled into it])}: per rig the store that varies the most
+    parameters over the largest box (in units of each range's own width: the product of the
+    widths relative to the union box) is the main one; every other store of that rig must be
+    poolable into it (pooled_runs.py, else a PoolError naming why)."""
+    by_rig = {}
+    for p in paths:
+        st = Campaign.open(p).store
+        by_rig.setdefault(st.spec.rig, []).append(st)
+    if not by_rig:
+        raise ValueError("no campaign stores given")
+    groups = {}
+    for rig, sts in by_rig.items():
+        main = max(sts, key=lambda st: (len(st.spec.ranges), _relative_volume(st, sts)))
+        others = [st for st in sts if st is not main]
+        for o in others:
+            check_poolable(main, o)
+        groups[rig] = (main, others)
+    return groups
 
 
 def open_stores(paths) -> dict:
-    """{rig: CampaignStore}, one store per rig (two for one rig are refused)."""
-    stores = {}
-    for p in paths:
-        st = Campaign.open(p).store
-        if st.spec.rig in stores:
-            raise ValueError(f"two stores for rig {st.spec.rig}: {stores[st.spec.rig].path} and {p}")
-        stores[st.spec.rig] = st
-    if not stores:
-        raise ValueError("no campaign stores given")
-    return stores
+    """{rig: the main store of the rig} (open_store_groups)."""
+    return {rig: main for rig, (main, _) in open_store_groups(paths).items()}
 
 
 def load_setup(paths, say=print, retrain: bool = False) -> Setup:
-    stores = open_stores(paths)
+    groups = open_store_groups(paths)
+    stores = {rig: main for rig, (main, _) in groups.items()}
     physics = check_same_physics(stores.values(), "diagnose with")
     nets, ranges, defaults = {}, {}, {}
     for rig, st in stores.items():
         missing = [n for n in BASE_PARAMETERS if n not in st.spec.ranges]
         if missing:
             raise ValueError(f"{st.path}: the diagnosis needs the base parameters {', '.join(missing)} varied")
-        nets.update(load_or_train(st, say, retrain))
+        nets.update(load_or_train(st, say, retrain, pooled=groups[rig][1]))
         for name, (lo, hi) in st.spec.ranges.items():
             if name in ranges:
                 lo, hi = max(lo, ranges[name][0]), min(hi, ranges[name][1])
             ranges[name] = (lo, hi)
         defaults.update(preset_conditions(st))
     cands = [c for c in registry() if c.parameter in ranges]
-    return Setup(stores, nets, ranges, cands, physics, defaults)
+    return Setup(stores, nets, ranges, cands, physics, defaults, {r: others for r, (_, others) in groups.items()})
 
 
 def observations_from_file(path: str | Path, material: str, setup: Setup) -> tuple[list[Observation], list[str]]:

@@ -152,15 +152,16 @@ def test_correlation(store, net: QuantityNet) -> float:
     return float(np.clip(c[np.triu_indices(len(points), 1)].mean(), 0.0, 0.95))
 
 
-def store_hash(store) -> str:
+def store_hash(store, pooled=()) -> str:
     h = hashlib.sha256()
     rep = replicate_store_path(store)
     if rep.exists():
         h.update(rep.read_bytes())
-    h.update(store.spec.to_json().encode())
-    h.update(json.dumps(store.metric_names).encode())
-    for a in (store.params, store.values, store.status):
-        h.update(np.ascontiguousarray(a).tobytes())
+    for st in (store, *pooled):
+        h.update(st.spec.to_json().encode())
+        h.update(json.dumps(st.metric_names).encode())
+        for a in (st.params, st.values, st.status):
+            h.update(np.ascontiguousarray(a).tobytes())
     return h.hexdigest()[:16]
 
 
@@ -168,11 +169,12 @@ def cache_dir(store) -> Path:
     return store.path.with_name(store.path.name + ".nets")
 
 
-def train(store, say=print) -> dict[Quantity, QuantityNet]:
-    """Trains one net per quantity of the store (seeded, deterministic on one machine)."""
+def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
+    """Trains one net per quantity of the store and the stores pooled with it (seeded,
+    deterministic on one machine)."""
     from nn.mlp import select_net
     nets = {}
-    for q, (names, x, y) in training_tables(store).items():
+    for q, (names, x, y) in training_tables(store, pooled).items():
         if len(y) < 20:
             say(f"  {q.key}: {len(y)} finished runs, too few to train a surrogate; skipped")
             continue
@@ -192,11 +194,11 @@ def train(store, say=print) -> dict[Quantity, QuantityNet]:
     return nets
 
 
-def load_or_train(store, say=print, retrain: bool = False) -> dict[Quantity, QuantityNet]:
-    """The store's nets from its cache when they were trained on exactly these runs, else
-    trained now and cached."""
+def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Quantity, QuantityNet]:
+    """The store's nets from its cache when they were trained on exactly these runs (its own and
+    those of the stores pooled with it, pooled_runs.py), else trained now and cached."""
     d = cache_dir(store)
-    key = store_hash(store)
+    key = store_hash(store, pooled)
     stamp = d / "store_hash.txt"
     if not retrain and stamp.exists() and stamp.read_text().strip() == key:
         nets = {}
@@ -209,8 +211,9 @@ def load_or_train(store, say=print, retrain: bool = False) -> dict[Quantity, Qua
                 np.savez(f, **n.to_arrays())
             nets[n.quantity] = n
         return nets
-    say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs; cached in {d})")
-    nets = train(store, say)
+    extra = "".join(f" + {(o.status == 1).sum()} of {o.path.name}" for o in pooled)
+    say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs{extra}; cached in {d})")
+    nets = train(store, say, pooled)
     rep = replicate_store_path(store)
     if rep.exists():
         from ..campaign import Campaign

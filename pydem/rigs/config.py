@@ -122,6 +122,29 @@ def set_value(cfg, key: str, value: Any):
         hook(name)
 
 
+def get_value(cfg, key: str) -> Any:
+    """The value of `key` (the keys set_value() takes) in a configuration; an effect parameter of
+    an effect that is not switched on reads as the parameter's neutral value (off)."""
+    parts = key.split(".")
+    if parts[0] == "effects" or (parts[0] == "params" and len(parts) > 1 and parts[1] == "effects"):
+        parts = parts[1:] if parts[0] == "params" else parts
+        if len(parts) == 3 and parts[2] in cfg.params.effects.get(parts[1], {}):
+            return cfg.params.effects[parts[1]][parts[2]]
+        from ..domain import effects as registry
+        spec = next((e for e in registry() if e["name"] == parts[1]), None)
+        param = next((q for q in (spec or {}).get("params", []) if len(parts) == 3 and q["name"] == parts[2]), None)
+        if param is None:
+            raise ConfigError(f"unknown key {key!r}")
+        return param["neutral"]
+    if parts[0] == "params" and len(parts) == 2:
+        return getattr(cfg.params, parts[1])
+    if len(parts) == 1 and parts[0] != "params" and parts[0] in _fields(cfg):
+        return getattr(cfg, parts[0])
+    if len(parts) == 1 and parts[0] in _fields(cfg.params):
+        return getattr(cfg.params, parts[0])
+    raise ConfigError(f"unknown key {key!r}")
+
+
 def check_field(obj, f, key: str | None = None):
     v, m, key = getattr(obj, f.name), f.metadata, key or f.name
     if m.get("choices") is not None and v not in m["choices"]:

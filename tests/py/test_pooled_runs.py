@@ -1,0 +1,61 @@
+"""A rig's other stores pooled into a diagnosis store's surrogates (pydem/calibration/pooled_runs.py):
+a three-parameter campaign's runs land in the six-parameter box at the values its preset gave
+the parameters it did not vary (an effect that was off: its neutral value), and stores whose
+runs are not points of the box are refused with the reason named."""
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from pydem.calibration.pooled_runs import PoolError, check_poolable, pooled_params
+from pydem.calibration.quantities import Quantity, training_tables
+from pydem.campaign.runner import resolved_config
+from pydem.campaign.spec import CampaignSpec
+
+BOX = {"friction": (0.05, 1.0), "rolling_friction": (0.0, 0.6), "restitution": (0.2, 0.9),
+       "wall_friction": (0.05, 1.0), "effects.cohesion_sjkr.cohesion_energy_density": (0.0, 1e5),
+       "size_spread": (0.0, 0.5)}
+THREE = {"friction": (0.2, 1.0), "rolling_friction": (0.05, 0.6), "restitution": (0.2, 0.9)}
+
+
+def store(name, ranges, params, values, preset="tiny", fixed=None, protocol=1, libdem="0.2.0"):
+    spec = CampaignSpec("aor", dict(ranges), preset, dict(fixed or {}))
+    prov = {"rig_protocol": protocol, "libdem": libdem, "rig_config": resolved_config(spec)}
+    return SimpleNamespace(spec=spec, path=Path(name), params=np.asarray(params, float), provenance=prov,
+                           rig_protocol=protocol, physics=".".join(libdem.split(".")[:2]),
+                           values=np.asarray(values, float), status=np.ones(len(params), int),
+                           metric_names=["angle_of_repose", "bulk_density"])
+
+
+def test_runs_map_to_the_preset_values_of_what_they_did_not_vary():
+    main = store("six.h5", BOX, [[0.5, 0.3, 0.5, 0.4, 2e4, 0.2]], [[35.0, 1500.0]])
+    other = store("three.h5", THREE, [[0.3, 0.1, 0.4], [0.9, 0.5, 0.6]], [[30.0, 1490.0], [41.0, 1470.0]])
+    check_poolable(main, other)
+    x = pooled_params(main, other)
+    # wall friction: the rig's knob (0.5, not the particles' friction); cohesion off: 0; spread: 0.1
+    assert np.allclose(x, [[0.3, 0.1, 0.4, 0.5, 0.0, 0.1], [0.9, 0.5, 0.6, 0.5, 0.0, 0.1]])
+    names, xs, ys = training_tables(main, [other])[Quantity("aor", "angle_of_repose")]
+    assert names == list(BOX) and xs.shape == (3, 6) and list(ys) == [35.0, 30.0, 41.0]
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(preset="default"), "rig/preset"),
+    (dict(protocol=2), "rig protocol"),
+    (dict(libdem="0.1.0"), "libdem"),
+    (dict(fixed={"lift_speed": 0.05}), "the rig differs in lift_speed"),
+    (dict(fixed={"wall_friction": 1.5}), "wall_friction = 1.5 lies outside"),
+])
+def test_stores_whose_runs_are_not_points_of_the_box_are_refused(change, words):
+    main = store("six.h5", BOX, [[0.5, 0.3, 0.5, 0.4, 2e4, 0.2]], [[35.0, 1500.0]])
+    kw = dict(preset="tiny", fixed=None, protocol=1, libdem="0.2.0") | change
+    other = store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]], **kw)
+    with pytest.raises(PoolError, match=words):
+        check_poolable(main, other)
+
+
+def test_a_store_varying_more_than_the_main_one_is_refused():
+    main = store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]])
+    wide = store("other.h5", {**THREE, "particles": (500, 700)}, [[0.3, 0.1, 0.4, 600]], [[30.0, 1490.0]])
+    with pytest.raises(PoolError, match="varies particles"):
+        check_poolable(main, wide)
