@@ -278,6 +278,106 @@ void dem_sweep_result_init(sweep_result *r)
     r->bad_nan = r->bad_out = r->bad_wall = r->bad_pair = INT64_MAX;
 }
 
+/* Phase 1 of a thread's sweep: which of its rows are direct (their reaction sums start at zero
+ * in the force arrays) and which deferred (listed in d->deferred from r0); returns the count. */
+static int64_t open_rows(dem_domain *d, int64_t r0, int64_t r1)
+{
+    int64_t n_deferred = 0;
+    for (int64_t i = r0; i < r1; i++) {
+        d->is_direct[i] = (uint8_t)direct(d, i, r0, r1);
+        if (d->is_direct[i])
+            for (int a = 0; a < 3; a++) d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
+        else
+            d->deferred[r0 + n_deferred++] = (int32_t)i;
+    }
+    return n_deferred;
+}
+
+/* Phase 2: rows [r0, r1) in batches of list entries — gather, law, scatter in list order —
+ * every row finished (direct) or parked (deferred) once the batch holding its end is done;
+ * the mesh contacts of each block of MESH_ROWS rows evaluated before its first row finishes. */
+static void sweep_rows(const sweep_ctx *ctx, int64_t r0, int64_t r1, int tid, sweep_result *res)
+{
+    dem_domain *d = ctx->d;
+    const double dt_hist = ctx->dt_hist;
+    pair_batch b; /* ~29 KB on the thread's stack */
+    /* as much again for the mesh contacts, where there are any: the domain's, reserved by
+     * the step (a second batch on the stack slowed the sweep without meshes by ~2 %) */
+    const int any_mesh = d->tris_cur.count > 0;
+    pair_batch *mesh_batch = any_mesh ? (pair_batch *)d->mesh_scratch + tid : NULL;
+    int64_t mesh_done = r0; /* rows before this have their mesh contacts evaluated */
+    const int64_t *start = d->pairs_cur.start;
+    int64_t row = r0, k = start[r0];
+    double acc[DEM_PAIR_BATCH][6]; /* force and torque sums of the batch's rows (from `row`) */
+    int32_t row_of[DEM_PAIR_BATCH]; /* the batch's contacts' rows (minus `row`) */
+    for (int a = 0; a < 6; a++) acc[0][a] = 0.0;
+    while (row < r1) {
+        /* a batch: at most DEM_PAIR_BATCH entries, from rows [row, cap) */
+        const int64_t cap = r1 - row > DEM_PAIR_BATCH ? row + DEM_PAIR_BATCH : r1;
+        const int64_t k1 = start[cap] - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : start[cap];
+        gather(ctx, row, k, k1, &b, row_of);
+        dem_pair_batch_law(&b, dt_hist);
+        if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx->hist);
+        /* rows [row, fin) end in this batch; row fin (if below the cap) goes on in the next */
+        int64_t fin = row;
+        while (fin < cap && start[fin + 1] <= k1) fin++;
+        const int64_t n_acc = fin < cap ? fin - row + 1 : fin - row; /* rows with contacts here */
+        for (int64_t r = 1; r < n_acc; r++)
+            for (int a = 0; a < 6; a++) acc[r][a] = 0.0;
+        /* in list order, so each row's sums are added up as the scalar order has them
+         * (one loop over the contacts, not rows then contacts: the end of a row is
+         * unpredictable for the branch predictor) */
+        for (int q = 0; q < b.m; q++) scatter(ctx, &b, q, acc[row_of[q]], &res->bad_pair, r0, r1);
+        for (int64_t o = 0; row < fin; row++, o++) {
+            if (any_mesh && row >= mesh_done) { /* the next block's mesh contacts, batched */
+                mesh_done = r1 - row > MESH_ROWS ? row + MESH_ROWS : r1;
+                dem_mesh_contacts_rows(d, row, mesh_done, dt_hist, mesh_batch, &res->bad_wall);
+            }
+            double f[3] = {acc[o][0], acc[o][1], acc[o][2]}, t[3] = {acc[o][3], acc[o][4], acc[o][5]};
+            /* direct: finish now; else park the row sums in the force arrays and finish
+             * after the barrier */
+            if (ctx->is_direct[row]) {
+                finish(ctx, row, f, t, res, 1);
+            } else {
+                for (int a = 0; a < 3; a++) {
+                    ctx->s.f[3 * row + a] = f[a];
+                    ctx->s.t[3 * row + a] = t[a];
+                }
+            }
+        }
+        /* the unfinished row's sums so far start the next batch's */
+        for (int a = 0; a < 6; a++) acc[0][a] = fin < cap ? acc[n_acc - 1][a] : 0.0;
+        k = k1;
+    }
+}
+
+/* Phase 3, after the barrier: the deferred particles (the first layer of each thread's rows:
+ * named by the rows before them) in equal shares among the nth threads, whichever thread's
+ * rows they are in (use_split: every thread's list and count known; else each its own). */
+static void finish_deferred(const sweep_ctx *ctx, int tid, int nth, int use_split, const int64_t *deferred_count,
+                            int64_t n_deferred, int64_t r0, sweep_result *res)
+{
+    dem_domain *d = ctx->d;
+    int64_t total = n_deferred, q0 = 0, q1 = n_deferred;
+    if (use_split) {
+        total = 0;
+        for (int u = 0; u < nth; u++) total += deferred_count[u];
+        q0 = total * tid / nth;
+        q1 = total * (tid + 1) / nth;
+    }
+    int64_t base = 0;
+    for (int u = use_split ? 0 : tid, last = use_split ? nth - 1 : tid; u <= last; u++) {
+        const int64_t count = use_split ? deferred_count[u] : n_deferred, from = use_split ? d->split[u] : r0;
+        for (int64_t q = q0 > base ? q0 : base; q < q1 && q < base + count; q++) {
+            const int64_t i = d->deferred[from + q - base];
+            double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
+            double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
+            finish(ctx, i, f, t, res, 0);
+        }
+        base += count;
+    }
+}
+
 sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
 {
     sweep_ctx c;
@@ -324,90 +424,16 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         const int64_t r0 = use_split ? d->split[tid] : n * tid / nth, r1 = use_split ? d->split[tid + 1] : n * (tid + 1) / nth;
         sweep_result res;
         dem_sweep_result_init(&res);
-        pair_batch b; /* ~29 KB on the thread's stack */
-        /* as much again for the mesh contacts, where there are any: the domain's, reserved by
-         * the step (a second batch on the stack slowed the sweep without meshes by ~2 %) */
-        const int any_mesh = d->tris_cur.count > 0;
-        pair_batch *mesh_batch = any_mesh ? (pair_batch *)d->mesh_scratch + tid : NULL;
-        int64_t mesh_done = r0; /* rows before this have their mesh contacts evaluated */
-        const int64_t *start = d->pairs_cur.start;
-        int64_t row = r0, k = start[r0];
-        double acc[DEM_PAIR_BATCH][6]; /* force and torque sums of the batch's rows (from `row`) */
-        int32_t row_of[DEM_PAIR_BATCH]; /* the batch's contacts' rows (minus `row`) */
-        for (int a = 0; a < 6; a++) acc[0][a] = 0.0;
-        int64_t n_deferred = 0;
-        for (int64_t i = r0; i < r1; i++) { /* direct particles' reaction sums start at zero */
-            d->is_direct[i] = (uint8_t)direct(d, i, r0, r1);
-            if (d->is_direct[i])
-                for (int a = 0; a < 3; a++) d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
-            else
-                d->deferred[r0 + n_deferred++] = (int32_t)i;
-        }
+        const int64_t n_deferred = open_rows(d, r0, r1);
         if (use_split) deferred_count[tid] = n_deferred;
-        while (row < r1) {
-            /* a batch: at most DEM_PAIR_BATCH entries, from rows [row, cap) */
-            const int64_t cap = r1 - row > DEM_PAIR_BATCH ? row + DEM_PAIR_BATCH : r1;
-            const int64_t k1 = start[cap] - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : start[cap];
-            gather(&ctx, row, k, k1, &b, row_of);
-            dem_pair_batch_law(&b, dt_hist);
-            if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx.hist);
-            /* rows [row, fin) end in this batch; row fin (if below the cap) goes on in the next */
-            int64_t fin = row;
-            while (fin < cap && start[fin + 1] <= k1) fin++;
-            const int64_t n_acc = fin < cap ? fin - row + 1 : fin - row; /* rows with contacts here */
-            for (int64_t r = 1; r < n_acc; r++)
-                for (int a = 0; a < 6; a++) acc[r][a] = 0.0;
-            /* in list order, so each row's sums are added up as the scalar order has them
-             * (one loop over the contacts, not rows then contacts: the end of a row is
-             * unpredictable for the branch predictor) */
-            for (int q = 0; q < b.m; q++) scatter(&ctx, &b, q, acc[row_of[q]], &res.bad_pair, r0, r1);
-            for (int64_t o = 0; row < fin; row++, o++) {
-                if (any_mesh && row >= mesh_done) { /* the next block's mesh contacts, batched */
-                    mesh_done = r1 - row > MESH_ROWS ? row + MESH_ROWS : r1;
-                    dem_mesh_contacts_rows(d, row, mesh_done, dt_hist, mesh_batch, &res.bad_wall);
-                }
-                double f[3] = {acc[o][0], acc[o][1], acc[o][2]}, t[3] = {acc[o][3], acc[o][4], acc[o][5]};
-                /* direct: finish now; else park the row sums in the force arrays and finish
-                 * after the barrier */
-                if (ctx.is_direct[row]) {
-                    finish(&ctx, row, f, t, &res, 1);
-                } else {
-                    for (int a = 0; a < 3; a++) {
-                        ctx.s.f[3 * row + a] = f[a];
-                        ctx.s.t[3 * row + a] = t[a];
-                    }
-                }
-            }
-            /* the unfinished row's sums so far start the next batch's */
-            for (int a = 0; a < 6; a++) acc[0][a] = fin < cap ? acc[n_acc - 1][a] : 0.0;
-            k = k1;
-        }
+        sweep_rows(&ctx, r0, r1, tid, &res);
 #ifdef _OPENMP
         if (use_split) d->split_busy[tid] = omp_get_wtime() - t_start;
 #else
         (void)t_start;
 #endif
 #pragma omp barrier
-        /* the deferred particles (the first layer of each thread's rows: named by the rows
-         * before them) in equal shares, whichever thread's rows they are in */
-        int64_t total = n_deferred, q0 = 0, q1 = n_deferred;
-        if (use_split) {
-            total = 0;
-            for (int u = 0; u < nth; u++) total += deferred_count[u];
-            q0 = total * tid / nth;
-            q1 = total * (tid + 1) / nth;
-        }
-        int64_t base = 0;
-        for (int u = use_split ? 0 : tid, last = use_split ? nth - 1 : tid; u <= last; u++) {
-            const int64_t count = use_split ? deferred_count[u] : n_deferred, from = use_split ? d->split[u] : r0;
-            for (int64_t q = q0 > base ? q0 : base; q < q1 && q < base + count; q++) {
-                const int64_t i = d->deferred[from + q - base];
-                double f[3] = {d->f[3 * i], d->f[3 * i + 1], d->f[3 * i + 2]};
-                double t[3] = {d->t[3 * i], d->t[3 * i + 1], d->t[3 * i + 2]};
-                finish(&ctx, i, f, t, &res, 0);
-            }
-            base += count;
-        }
+        finish_deferred(&ctx, tid, nth, use_split, deferred_count, n_deferred, r0, &res);
         maxdisp2 = res.maxdisp2;
         bad_nan = res.bad_nan;
         bad_out = res.bad_out;
