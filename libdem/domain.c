@@ -107,8 +107,7 @@ static void free_wall_list(wall_list *w)
 {
     dem_free(w->start);
     dem_free(w->wall);
-    dem_free(w->xi);
-    dem_free(w->mr);
+    dem_free(w->hist);
     dem_free(w->force);
 }
 

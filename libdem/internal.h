@@ -75,47 +75,7 @@ typedef struct mesh_wall {
     double averaged_time;    /* sum of dt, s */
 } mesh_wall;
 
-/* Mesh-triangle contact candidates, grouped by particle (CSR over particles). An entry is
- * "active" when it carried an accepted contact at the last evaluation. */
-typedef struct tri_list {
-    int64_t n_rows;          /* particles covered */
-    int64_t count, capacity;
-    int64_t *start;          /* n + 1 */
-    int64_t start_cap;       /* entries allocated for start (grown, never shrunk: no allocation in a warm step) */
-    int32_t *mesh, *tri;
-    uint8_t *active;
-    double *hist;            /* 6 per entry: tangential spring (3), rolling torque (3) */
-    double *force;           /* 3 per entry: force on the particle, last step */
-    double *torque;          /* 3 per entry: torque on the particle, kept only from the contact's
-                              * evaluation to the particle's finish within one sweep */
-    double *point;           /* 3 per entry: contact point, last step */
-    double *normal;          /* 3 per entry: contact normal (towards the particle), last step */
-} tri_list;
-
-/* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the
- * partner j, the periodic image code of j, the contact histories, and whether the pair
- * touched at the last evaluation (its reaction slot then holds its force, where the slot
- * is current: see `slot`). */
-typedef struct pair_list {
-    int64_t n_rows;       /* particles covered */
-    int64_t count, capacity;
-    int64_t *start;       /* n_rows + 1 */
-    int64_t start_cap;    /* entries allocated for start */
-    int32_t *j;
-    uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
-    uint8_t *active;
-    double *hist;         /* 6 per entry: tangential spring xi (3), rolling torque (3) */
-} pair_list;
-
-/* Wall contact candidates, grouped by particle (CSR over particles). */
-typedef struct wall_list {
-    int64_t count, capacity;
-    int64_t *start;       /* n + 1 */
-    int64_t start_cap;    /* entries allocated for start */
-    int32_t *wall;
-    double *xi, *mr;      /* 3 per entry */
-    double *force;        /* 3 per entry: force on the particle, last step */
-} wall_list;
+#include "contact_lists.h"
 
 #define DEM_SPLIT_MAX 64 /* threads whose rows the sweep balances (more: an even split) */
 

@@ -60,8 +60,9 @@ static int wall_list_reserve(wall_list *wl, int64_t need)
     if (need <= wl->capacity) return 1;
     int64_t c = margin(need);
     void **i32[] = {(void **)&wl->wall};
-    void **vec3[] = {(void **)&wl->xi, (void **)&wl->mr, (void **)&wl->force};
-    if (!dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(vec3, 3, (size_t)c * 3, sizeof(double)))
+    void **vec3[] = {(void **)&wl->force}, **vec6[] = {(void **)&wl->hist};
+    if (!dem_realloc_all(i32, 1, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(vec3, 1, (size_t)c * 3, sizeof(double)) ||
+        !dem_realloc_all(vec6, 1, (size_t)c * 6, sizeof(double)))
         return 0;
     wl->capacity = c;
     return 1;
@@ -483,13 +484,12 @@ static dem_status build_wall_list(dem_domain *d, int64_t n)
                 wl->wall[wc] = w;
                 /* history from the old list */
                 int32_t oi = d->perm[i];
-                double *xi = wl->xi + 3 * wc, *mr = wl->mr + 3 * wc;
-                xi[0] = xi[1] = xi[2] = mr[0] = mr[1] = mr[2] = 0.0;
+                double *h = wl->hist + 6 * wc;
+                for (int a = 0; a < 6; a++) h[a] = 0.0;
                 if (wold->start && oi < old_rows)
                     for (int64_t k = wold->start[oi]; k < wold->start[oi + 1]; k++)
                         if (wold->wall[k] == w) {
-                            memcpy(xi, wold->xi + 3 * k, 3 * sizeof(double));
-                            memcpy(mr, wold->mr + 3 * k, 3 * sizeof(double));
+                            memcpy(h, wold->hist + 6 * k, 6 * sizeof(double));
                         }
                 wl->force[3 * wc] = wl->force[3 * wc + 1] = wl->force[3 * wc + 2] = 0.0;
                 wc++;

@@ -49,9 +49,9 @@ void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
     for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++) {
         const plane_wall *pw = &d->walls[wl->wall[k]];
         const double dist = (xi_[pw->def.axis] - pw->def.position) * pw->def.side;
-        double *hxi = wl->xi + 3 * k, *hmr = wl->mr + 3 * k, *wf = wl->force + 3 * k;
+        double *h = wl->hist + 6 * k, *wf = wl->force + 3 * k;
         if (dist >= ri) {
-            hxi[0] = hxi[1] = hxi[2] = hmr[0] = hmr[1] = hmr[2] = 0.0;
+            for (int a = 0; a < 6; a++) h[a] = 0.0;
             wf[0] = wf[1] = wf[2] = 0.0;
             continue;
         }
@@ -60,7 +60,7 @@ void dem_wall_contacts(dem_domain *d, int64_t i, double dt_hist, double *f, doub
         const double ci = wall_contact_in(&c, pw->normal, dist, ri, d->inv_mass[i], vi, wi, pw->def.velocity, no_spin);
         if (c.overlap > d->def.max_overlap_ratio * ri && i < *bad) *bad = i;
         contact_out o;
-        contact_law(&row_pairs[pw->def.material.index], &c, dt_hist, hxi, hmr, &o);
+        contact_law(&row_pairs[pw->def.material.index], &c, dt_hist, h, h + 3, &o);
         for (int a = 0; a < 3; a++) {
             f[a] += o.force[a];
             t[a] += -ci * o.cross[a] + o.mr[a];

@@ -263,7 +263,7 @@ static int write_contacts(hid_t f, const dem_domain *d)
     r = 0;
     for (int64_t i = 0; ok && i < d->n; i++)
         for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++)
-            if (nonzero(wl->xi + 3 * k, 3) || nonzero(wl->mr + 3 * k, 3) || nonzero(wl->force + 3 * k, 3)) {
+            if (nonzero(wl->hist + 6 * k, 6) || nonzero(wl->force + 3 * k, 3)) {
                 ids[r] = d->id[i];
                 iv[r] = wl->wall[k];
                 pack_fields(wf, PLANE_FIELDS, k, h + (int64_t)ww * r);

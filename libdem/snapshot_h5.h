@@ -17,7 +17,7 @@ typedef struct contact_field {
     int width;
 } contact_field;
 
-enum { PAIR_FIELDS = 2, PLANE_FIELDS = 3, MESH_FIELDS = 4 };
+enum { PAIR_FIELDS = 2, PLANE_FIELDS = 2, MESH_FIELDS = 4 };
 
 /* pair_history_reaction: tangential spring and rolling torque (6), the reaction slot (6) */
 static inline int pair_fields(const dem_domain *d, contact_field f[PAIR_FIELDS])
@@ -27,13 +27,12 @@ static inline int pair_fields(const dem_domain *d, contact_field f[PAIR_FIELDS])
     return 6 + 6;
 }
 
-/* plane_history_force: spring (3), rolling torque (3), force on the particle (3) */
+/* plane_history_force: spring and rolling torque (6), force on the particle (3) */
 static inline int plane_fields(const dem_domain *d, contact_field f[PLANE_FIELDS])
 {
-    f[0] = (contact_field){d->walls_cur.xi, 3};
-    f[1] = (contact_field){d->walls_cur.mr, 3};
-    f[2] = (contact_field){d->walls_cur.force, 3};
-    return 3 + 3 + 3;
+    f[0] = (contact_field){d->walls_cur.hist, 6};
+    f[1] = (contact_field){d->walls_cur.force, 3};
+    return 6 + 3;
 }
 
 /* mesh_history_force_point_normal: spring and rolling torque (6), force, point, normal (3 each) */

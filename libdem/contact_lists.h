@@ -1,0 +1,53 @@
+/* The three contact lists — pair (Verlet) entries, plane-wall candidates, triangle candidates —
+ * each a CSR over the particles, each entry's history in one layout: 6 doubles, the tangential
+ * spring (3) then the rolling torque (3), which contact_law() takes as (h, h + 3). The pair
+ * entries' reaction slots live beside the particles (dem_domain.slot). Built by neighbor.c
+ * (pairs, planes) and mesh_bins.c (triangles), histories carried over between builds. */
+#ifndef DEM_CONTACT_LISTS_H
+#define DEM_CONTACT_LISTS_H
+
+#include <stdint.h>
+
+/* Mesh-triangle contact candidates, grouped by particle (CSR over particles). An entry is
+ * "active" when it carried an accepted contact at the last evaluation. */
+typedef struct tri_list {
+    int64_t n_rows;          /* particles covered */
+    int64_t count, capacity;
+    int64_t *start;          /* n + 1 */
+    int64_t start_cap;       /* entries allocated for start (grown, never shrunk: no allocation in a warm step) */
+    int32_t *mesh, *tri;
+    uint8_t *active;
+    double *hist;            /* 6 per entry: tangential spring (3), rolling torque (3) */
+    double *force;           /* 3 per entry: force on the particle, last step */
+    double *torque;          /* 3 per entry: torque on the particle, kept only from the contact's
+                              * evaluation to the particle's finish within one sweep */
+    double *point;           /* 3 per entry: contact point, last step */
+    double *normal;          /* 3 per entry: contact normal (towards the particle), last step */
+} tri_list;
+
+/* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the
+ * partner j, the periodic image code of j, the contact histories, and whether the pair
+ * touched at the last evaluation (its reaction slot then holds its force, where the slot
+ * is current: see `slot`). */
+typedef struct pair_list {
+    int64_t n_rows;       /* particles covered */
+    int64_t count, capacity;
+    int64_t *start;       /* n_rows + 1 */
+    int64_t start_cap;    /* entries allocated for start */
+    int32_t *j;
+    uint8_t *image;       /* 0..26: periodic shift of j, 13 = none */
+    uint8_t *active;
+    double *hist;         /* 6 per entry: tangential spring xi (3), rolling torque (3) */
+} pair_list;
+
+/* Wall contact candidates, grouped by particle (CSR over particles). */
+typedef struct wall_list {
+    int64_t count, capacity;
+    int64_t *start;       /* n + 1 */
+    int64_t start_cap;    /* entries allocated for start */
+    int32_t *wall;
+    double *hist;         /* 6 per entry: tangential spring (3), rolling torque (3) */
+    double *force;        /* 3 per entry: force on the particle, last step */
+} wall_list;
+
+#endif
