@@ -50,4 +50,26 @@ typedef struct wall_list {
     double *force;        /* 3 per entry: force on the particle, last step */
 } wall_list;
 
+/* One touching contact of particle i as dem_visit_contacts (contact_visit.c) hands it over. */
+typedef struct contact_view {
+    int64_t i;            /* the particle (internal index) */
+    int kind;             /* DEM_CONTACT_PARTICLE, _PLANE or _MESH */
+    int64_t k;            /* its entry in that list */
+    int32_t j;            /* the partner particle (pairs), else -1 */
+    int partner_material; /* the partner particle's, plane wall's or mesh's material */
+    double n[3];          /* pairs: x_i - x_j (j's periodic image), not normalised; walls: unit normal towards i */
+    double dist;          /* pairs: |n|; plane: centre-to-plane distance; mesh: centre-to-contact-point distance */
+    double overlap;       /* pairs and planes > 0; mesh: as evaluated (VISIT_EVALUATED may hand over <= 0) */
+    const double *point;  /* mesh: the contact point (3); else NULL */
+    const double *force;  /* on i, from the last evaluation (pairs: the reaction slot) */
+} contact_view;
+
+/* VISIT_EVALUATED: the contacts the last force evaluation had (pairs flagged active, mesh
+ * contacts selected); VISIT_GEOMETRIC: every pair and plane entry that overlaps now (also
+ * before any evaluation), mesh contacts as selected and still overlapping. */
+enum { VISIT_EVALUATED = 0, VISIT_GEOMETRIC = 1 };
+struct dem_domain;
+typedef void (*contact_visitor)(const struct dem_domain *d, const contact_view *c, void *ctx);
+void dem_visit_contacts(const struct dem_domain *d, int64_t i, int mode, contact_visitor fn, void *ctx);
+
 #endif

@@ -31,6 +31,36 @@ static void put(dem_contact *c, dem_particle_id i, dem_particle_id j, int kind, 
     c->overlap = overlap;
 }
 
+typedef struct contact_sink {
+    dem_contact *out;
+    int64_t capacity, m;
+} contact_sink;
+
+/* One visited contact into the user's array (counted even when the array is full). */
+static void put_contact(const dem_domain *d, const contact_view *c, void *ctx)
+{
+    contact_sink *s = ctx;
+    if (s->m < s->capacity) {
+        const int64_t i = c->i, k = c->k;
+        const double *xi = d->x + 3 * i;
+        const double friction = dem_pair_props(d, d->mat[i], c->partner_material)->def.friction;
+        double q[3];
+        if (c->kind == DEM_CONTACT_PARTICLE) {
+            const double u[3] = {c->n[0] / c->dist, c->n[1] / c->dist, c->n[2] / c->dist};
+            for (int a = 0; a < 3; a++) q[a] = xi[a] - (d->radius[i] - 0.5 * c->overlap) * u[a];
+            put(s->out + s->m, d->id[i], d->id[c->j], DEM_CONTACT_PARTICLE, -1, -1, q, u, c->force, c->overlap, friction);
+        } else if (c->kind == DEM_CONTACT_PLANE) {
+            for (int a = 0; a < 3; a++) q[a] = xi[a] - c->dist * c->n[a];
+            put(s->out + s->m, d->id[i], -1, DEM_CONTACT_PLANE, d->walls_cur.wall[k], -1, q, c->n, c->force, c->overlap,
+                friction);
+        } else {
+            put(s->out + s->m, d->id[i], -1, DEM_CONTACT_MESH, d->tris_cur.mesh[k], d->tris_cur.tri[k], c->point, c->n,
+                c->force, c->overlap, friction);
+        }
+    }
+    s->m++;
+}
+
 dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, int64_t *count)
 {
     if (!d) return DEM_ERR_NULL;
@@ -42,50 +72,9 @@ dem_status dem_contacts_get(dem_domain *d, dem_contact *out, int64_t capacity, i
         dem_status s = dem_domain_step(d, 0);
         if (s < 0) return s;
     }
-    const pair_list *pl = &d->pairs_cur;
-    const wall_list *wl = &d->walls_cur;
-    const tri_list *tl = &d->tris_cur;
-    int64_t m = 0;
-    for (int64_t i = 0; i < d->n; i++) {
-        const double *xi = d->x + 3 * i;
-        for (int64_t k = pl->start ? pl->start[i] : 0; pl->start && k < pl->start[i + 1]; k++) {
-            if (!pl->active[k]) continue;
-            const int32_t j = pl->j[k];
-            double n[3], r;
-            const double delta = dem_pair_separation(d, i, k, n, &r);
-            if (delta <= 0.0) continue;
-            if (m < capacity) {
-                double u[3] = {n[0] / r, n[1] / r, n[2] / r}, q[3];
-                for (int a = 0; a < 3; a++) q[a] = xi[a] - (d->radius[i] - 0.5 * delta) * u[a];
-                put(out + m, d->id[i], d->id[j], DEM_CONTACT_PARTICLE, -1, -1, q, u, d->slot + 6 * k, delta,
-                    dem_pair_props(d, d->mat[i], d->mat[j])->def.friction);
-            }
-            m++;
-        }
-        for (int64_t k = wl->start ? wl->start[i] : 0; wl->start && k < wl->start[i + 1]; k++) {
-            const plane_wall *pw = &d->walls[wl->wall[k]];
-            const double dist = (xi[pw->def.axis] - pw->def.position) * pw->def.side;
-            if (dist >= d->radius[i]) continue;
-            if (m < capacity) {
-                double q[3];
-                for (int a = 0; a < 3; a++) q[a] = xi[a] - dist * pw->normal[a];
-                put(out + m, d->id[i], -1, DEM_CONTACT_PLANE, wl->wall[k], -1, q, pw->normal, wl->force + 3 * k,
-                    d->radius[i] - dist, dem_pair_props(d, d->mat[i], pw->def.material.index)->def.friction);
-            }
-            m++;
-        }
-        for (int64_t k = tl->start ? tl->start[i] : 0; tl->start && k < tl->start[i + 1]; k++) {
-            if (!tl->active[k]) continue;
-            const double *q = tl->point + 3 * k;
-            const double dist = sqrt((xi[0] - q[0]) * (xi[0] - q[0]) + (xi[1] - q[1]) * (xi[1] - q[1]) +
-                                     (xi[2] - q[2]) * (xi[2] - q[2]));
-            if (m < capacity)
-                put(out + m, d->id[i], -1, DEM_CONTACT_MESH, tl->mesh[k], tl->tri[k], q, tl->normal + 3 * k,
-                    tl->force + 3 * k, d->radius[i] - dist,
-                    dem_pair_props(d, d->mat[i], d->meshes[tl->mesh[k]].material)->def.friction);
-            m++;
-        }
-    }
+    contact_sink sink = {out, capacity, 0};
+    for (int64_t i = 0; i < d->n; i++) dem_visit_contacts(d, i, VISIT_EVALUATED, put_contact, &sink);
+    const int64_t m = sink.m;
     *count = m;
     if (capacity > 0 && capacity < m)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_contacts_get: %lld contacts, room for %lld (the first written)",

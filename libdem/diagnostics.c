@@ -10,6 +10,26 @@ static double hertz_energy(double e_star, double r_eff, double delta)
     return 8.0 / 15.0 * e_star * sqrt(r_eff) * pow(delta, 2.5);
 }
 
+/* One overlapping contact: counted, its Hertz energy and overlap ratio. */
+static void add_contact(const dem_domain *d, const contact_view *c, void *ctx)
+{
+    dem_diagnostics *out = ctx;
+    const int64_t i = c->i;
+    const double e_star = dem_pair_props(d, d->mat[i], c->partner_material)->e_star;
+    out->contact_count++;
+    if (c->kind == DEM_CONTACT_PARTICLE) {
+        const double ri = d->radius[i], rj = d->radius[c->j];
+        out->elastic_energy += hertz_energy(e_star, ri * rj / (ri + rj), c->overlap);
+        const double ratio = c->overlap / fmin(ri, rj);
+        if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
+        return;
+    }
+    out->wall_contact_count++;
+    out->elastic_energy += hertz_energy(e_star, d->radius[i], c->overlap);
+    const double ratio = c->overlap / d->radius[i];
+    if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
+}
+
 dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
 {
     if (!d) return DEM_ERR_NULL;
@@ -30,50 +50,6 @@ dem_status dem_domain_diagnostics(dem_domain *d, dem_diagnostics *out)
                                0.5 * I * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
         for (int a = 0; a < 3; a++) out->momentum[a] += m * v[a];
     }
-    const pair_list *pl = &d->pairs_cur;
-    for (int64_t i = 0; i < d->n; i++) {
-        for (int64_t k = pl->start[i]; k < pl->start[i + 1]; k++) {
-            int32_t j = pl->j[k];
-            double r2 = 0.0;
-            for (int a = 0; a < 3; a++) {
-                double u = d->x[3 * i + a] - d->x[3 * j + a] -
-                           dem_image_sign[pl->image[k]][a] * (d->def.hi[a] - d->def.lo[a]);
-                r2 += u * u;
-            }
-            double delta = d->radius[i] + d->radius[j] - sqrt(r2);
-            if (delta <= 0.0) continue;
-            out->contact_count++;
-            const pair_props *pp = dem_pair_props(d, d->mat[i], d->mat[j]);
-            out->elastic_energy += hertz_energy(pp->e_star, d->radius[i] * d->radius[j] / (d->radius[i] + d->radius[j]), delta);
-            double ratio = delta / fmin(d->radius[i], d->radius[j]);
-            if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
-        }
-        const wall_list *wl = &d->walls_cur;
-        for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++) {
-            const plane_wall *pw = &d->walls[wl->wall[k]];
-            double delta = d->radius[i] - (d->x[3 * i + pw->def.axis] - pw->def.position) * pw->def.side;
-            if (delta <= 0.0) continue;
-            out->contact_count++;
-            out->wall_contact_count++;
-            out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], pw->def.material.index)->e_star, d->radius[i], delta);
-            double ratio = delta / d->radius[i];
-            if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
-        }
-        const tri_list *tl = &d->tris_cur;
-        for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) { /* accepted mesh contacts */
-            if (!tl->active[k]) continue;
-            const double *q = tl->point + 3 * k, *p = d->x + 3 * i;
-            double u2 = 0.0;
-            for (int a = 0; a < 3; a++) u2 += (p[a] - q[a]) * (p[a] - q[a]);
-            double delta = d->radius[i] - sqrt(u2);
-            if (delta <= 0.0) continue;
-            out->contact_count++;
-            out->wall_contact_count++;
-            int wm = d->meshes[tl->mesh[k]].material;
-            out->elastic_energy += hertz_energy(dem_pair_props(d, d->mat[i], wm)->e_star, d->radius[i], delta);
-            double ratio = delta / d->radius[i];
-            if (ratio > out->max_overlap_ratio) out->max_overlap_ratio = ratio;
-        }
-    }
+    for (int64_t i = 0; i < d->n; i++) dem_visit_contacts(d, i, VISIT_GEOMETRIC, add_contact, out);
     return DEM_OK;
 }

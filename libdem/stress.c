@@ -82,6 +82,41 @@ static void add_contact(double *s, const double *f, const double *l)
         for (int j = 0; j < 3; j++) s[3 * i + j] -= f[i] * l[j];
 }
 
+typedef struct contact_stress {
+    const dem_region *g;
+    double *s; /* the contact part of the stress (9), volume not yet divided */
+} contact_stress;
+
+/* One contact's share -f (x) l, l from the particle's centre to the contact point: a pair adds
+ * to both sides whose particle is in the region, a wall contact to its particle's. */
+static void add_visited(const dem_domain *d, const contact_view *c, void *ctx)
+{
+    const contact_stress *cs = ctx;
+    const int64_t i = c->i;
+    const double *xi = d->x + 3 * i;
+    const int in_i = inside(cs->g, xi);
+    if (c->kind == DEM_CONTACT_PARTICLE) {
+        const int in_j = inside(cs->g, d->x + 3 * (int64_t)c->j);
+        const double *f = c->force, *n = c->n, r = c->dist; /* force on i */
+        const double ci = d->radius[i] - 0.5 * c->overlap, cj = d->radius[c->j] - 0.5 * c->overlap;
+        if (in_i) {
+            double l[3] = {-ci * n[0] / r, -ci * n[1] / r, -ci * n[2] / r};
+            add_contact(cs->s, f, l);
+        }
+        if (in_j) {
+            double l[3] = {cj * n[0] / r, cj * n[1] / r, cj * n[2] / r}, fj[3] = {-f[0], -f[1], -f[2]};
+            add_contact(cs->s, fj, l);
+        }
+    } else if (in_i && c->kind == DEM_CONTACT_PLANE) {
+        double l[3] = {-c->dist * c->n[0], -c->dist * c->n[1], -c->dist * c->n[2]}; /* to the surface */
+        add_contact(cs->s, c->force, l);
+    } else if (in_i) {
+        const double *q = c->point;
+        double l[3] = {q[0] - xi[0], q[1] - xi[1], q[2] - xi[2]};
+        add_contact(cs->s, c->force, l);
+    }
+}
+
 dem_status dem_region_stress(dem_domain *d, const dem_region *g, dem_stress *out)
 {
     if (!d) return DEM_ERR_NULL;
@@ -109,45 +144,10 @@ dem_status dem_region_stress(dem_domain *d, const dem_region *g, dem_stress *out
     out->solid_fraction = solid / volume;
 
     double *sc = out->contact, *sk = out->kinetic;
-    const pair_list *pl = &d->pairs_cur;
-    const wall_list *wl = &d->walls_cur;
-    const tri_list *tl = &d->tris_cur;
+    contact_stress cs = {g, sc};
     for (int64_t i = 0; i < d->n; i++) {
-        const double *xi = d->x + 3 * i;
-        const int in_i = inside(g, xi);
-        for (int64_t k = pl->start[i]; k < pl->start[i + 1]; k++) { /* pairs: both sides */
-            if (!pl->active[k]) continue;
-            const int32_t j = pl->j[k];
-            const int in_j = inside(g, d->x + 3 * j);
-            if (!in_i && !in_j) continue;
-            const double *f = d->slot + 6 * k; /* force on i */
-            double n[3], r;
-            const double delta = dem_pair_separation(d, i, k, n, &r);
-            if (delta <= 0.0) continue;
-            const double ci = d->radius[i] - 0.5 * delta, cj = d->radius[j] - 0.5 * delta;
-            if (in_i) {
-                double l[3] = {-ci * n[0] / r, -ci * n[1] / r, -ci * n[2] / r};
-                add_contact(sc, f, l);
-            }
-            if (in_j) {
-                double l[3] = {cj * n[0] / r, cj * n[1] / r, cj * n[2] / r}, fj[3] = {-f[0], -f[1], -f[2]};
-                add_contact(sc, fj, l);
-            }
-        }
-        if (!in_i) continue;
-        for (int64_t k = wl->start[i]; k < wl->start[i + 1]; k++) { /* plane walls */
-            const plane_wall *pw = &d->walls[wl->wall[k]];
-            const double dist = (xi[pw->def.axis] - pw->def.position) * pw->def.side;
-            if (dist >= d->radius[i]) continue;
-            double l[3] = {-dist * pw->normal[0], -dist * pw->normal[1], -dist * pw->normal[2]}; /* to the surface */
-            add_contact(sc, wl->force + 3 * k, l);
-        }
-        for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) { /* mesh walls */
-            if (!tl->active[k]) continue;
-            const double *q = tl->point + 3 * k;
-            double l[3] = {q[0] - xi[0], q[1] - xi[1], q[2] - xi[2]};
-            add_contact(sc, tl->force + 3 * k, l);
-        }
+        dem_visit_contacts(d, i, VISIT_EVALUATED, add_visited, &cs);
+        if (!inside(g, d->x + 3 * i)) continue;
         const double m = 1.0 / d->inv_mass[i];
         double u[3];
         for (int a = 0; a < 3; a++) u[a] = d->v[3 * i + a] - out->mean_velocity[a];
