@@ -4,7 +4,9 @@ three-parameter campaign at the slow-lift default preset): for each of the eight
 base model's posterior (friction, rolling friction, restitution), the angle the surrogate gives
 at the estimate, whether the estimate sits on a range edge, and seed 000's ±5 % window. One
 measured angle per material cannot pin three parameters: the posterior is a ridge, and the
-table says how narrow each parameter still gets.
+table says how narrow each parameter still gets. Beside each estimate: what the default ring
+shear surrogates predict for it (pre-shear 2 kPa, shear point 60 %, the candidate effects at
+neutral), flagged where the estimate lies outside the ring-shear store's box.
 
     .venv/bin/python bench/jku_calibration.py [--stores S ...]  # -> bench/results/jku_calibration.{json,md}
 """
@@ -15,6 +17,8 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
@@ -23,7 +27,20 @@ from pydem.calibration.setup import load_setup, observations_from_file  # noqa: 
 from pydem.measurements import load as load_measurements  # noqa: E402
 
 MEAS = ROOT / "data/measurements/jku_angle_of_repose.csv"
-JKU_STORES = ("data/campaigns/aor_jku.h5",)
+JKU_STORES = ("data/campaigns/aor_jku_wide.h5", "data/campaigns/aor_jku.h5")
+RING_SHEAR = "data/campaigns/diag_ring_shear_default.h5"
+RING_SHEAR_AT = {"preshear_stress": 2000.0, "shear_fraction": 0.6}
+
+
+def ring_shear_prediction(rs, theta: dict) -> dict:
+    """The ring-shear surrogates at the base parameters theta, candidates at neutral."""
+    values = dict(theta)
+    for c in rs.candidates:
+        values.setdefault(c.parameter, c.neutral_value(theta))
+    values.update(RING_SHEAR_AT)
+    out = {q.metric: float(net(np.array([[values[n] for n in net.input_names]]))[0]) for q, net in rs.nets.items()}
+    out["outside_box"] = [n for n, (lo, hi) in rs.ranges.items() if n in theta and not lo <= theta[n] <= hi]
+    return out
 
 
 def main() -> int:
@@ -32,6 +49,7 @@ def main() -> int:
     stores = ap.parse_args().stores
     setup = load_setup([ROOT / s for s in stores], say=lambda *_: None)
     fits = {q.key: (n.r2, n.rmse) for q, n in setup.nets.items()}
+    rs = load_setup([ROOT / RING_SHEAR], say=lambda *_: None)
     materials = sorted({m.material for m in load_measurements(MEAS, None)})
     rows = []
     for name in materials:
@@ -43,6 +61,7 @@ def main() -> int:
         rows.append({"material": name, "measured": obs[0].value, "model_at_estimate": model,
                      "chi2": c.fit.chi2, "admissible_5pc": c.screening["admissible"],
                      "screened": c.screening["samples"],
+                     "ring_shear_at_estimate": ring_shear_prediction(rs, c.fit.as_dict()),
                      "parameters": {k: {x: p[x] for x in ("estimate", "mean", "lo", "hi", "at_edge")} for k, p in post.items()}})
         print(f"{name:18s} {obs[0].value:6.2f} deg  model {model:6.2f}  admissible {c.screening['admissible']:7d}  "
               + "  ".join(f"{k} {p['mean']:.3f} [{p['lo']:.3f}, {p['hi']:.3f}]{'*' if p['at_edge'] else ''}"
@@ -52,12 +71,16 @@ def main() -> int:
     lines = [f"Stores: {', '.join(stores)}; surrogates (hold-out R², RMSE): "
              + "; ".join(f"{k} {r2:.2f}, {rmse:.3g}" for k, (r2, rmse) in fits.items()), "",
              "| material | measured | surrogate at estimate | ±5 % admissible of 2^18 | friction mean [95 %] | "
-             "rolling friction mean [95 %] | restitution mean [95 %] |", "|---|---|---|---|---|---|---|"]
+             "rolling friction mean [95 %] | restitution mean [95 %] | ring shear at the estimate: μ_ie-ps, μ_ie-s (60 %), ρ_b |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         p = r["parameters"]
         cell = lambda k: f"{p[k]['mean']:.2f} [{p[k]['lo']:.2f}, {p[k]['hi']:.2f}]" + (" (edge)" if p[k]["at_edge"] else "")  # noqa: E731
+        rsp = r["ring_shear_at_estimate"]
+        rs_cell = (f"{rsp['mu_ie_ps']:.2f}, {rsp['mu_ie_s']:.2f}, {rsp['bulk_density']:.0f} kg/m³"
+                   + (f" (extrapolated: {', '.join(rsp['outside_box'])} outside the box)" if rsp["outside_box"] else ""))
         lines.append(f"| {r['material']} | {r['measured']:.2f}° | {r['model_at_estimate']:.2f}° | {r['admissible_5pc']:,} | "
-                     f"{cell('friction')} | {cell('rolling_friction')} | {cell('restitution')} |")
+                     f"{cell('friction')} | {cell('rolling_friction')} | {cell('restitution')} | {rs_cell} |")
     out.with_suffix(".md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0
