@@ -87,9 +87,10 @@ def _coerce(value: Any, default: Any, key: str):
     return value if not isinstance(default, str) else str(value)
 
 
-def set_value(cfg, key: str, value: Any):
-    """Sets `key` (a field of the config, `params.<field>`, a Params field name, or
-    `effects.<effect>.<parameter>`) from a string or a value, then checks its range."""
+def _locate(cfg, key: str):
+    """Where `key` lives: ("effect", effect name, its parameter's registry entry) or ("field",
+    the object holding it (the config or its params), the field name); a ConfigError naming
+    the problem when there is no such key."""
     parts = key.split(".")
     if parts[0] == "effects" or (parts[0] == "params" and len(parts) > 1 and parts[1] == "effects"):
         parts = parts[1:] if parts[0] == "params" else parts
@@ -99,11 +100,10 @@ def set_value(cfg, key: str, value: Any):
         spec = next((e for e in registry() if e["name"] == parts[1]), None)
         if spec is None:
             raise ConfigError(f"{key}: unknown effect {parts[1]!r} (known: {', '.join(e['name'] for e in registry())})")
-        names = [p["name"] for p in spec["params"]]
-        if parts[2] not in names:
-            raise ConfigError(f"{key}: effect {parts[1]!r} has parameters {names}")
-        cfg.params.effects.setdefault(parts[1], {})[parts[2]] = _coerce(value, 0.0, key)
-        return
+        param = next((q for q in spec["params"] if q["name"] == parts[2]), None)
+        if param is None:
+            raise ConfigError(f"{key}: effect {parts[1]!r} has parameters {[q['name'] for q in spec['params']]}")
+        return "effect", parts[1], param
     target, name = cfg, parts[-1]
     if parts[0] == "params" and len(parts) == 2:
         target = cfg.params
@@ -111,12 +111,22 @@ def set_value(cfg, key: str, value: Any):
         raise ConfigError(f"unknown key {key!r}")
     elif name not in _fields(cfg) and name in _fields(cfg.params):
         target = cfg.params
-    fields = _fields(target)
-    if name not in fields or name == "params":
+    if name not in _fields(target) or name == "params":
         known = sorted(set(_fields(cfg)) - {"params"}) + sorted(_fields(cfg.params))
         raise ConfigError(f"unknown key {key!r}; known keys: {', '.join(known)}")
+    return "field", target, name
+
+
+def set_value(cfg, key: str, value: Any):
+    """Sets `key` (a field of the config, `params.<field>`, a Params field name, or
+    `effects.<effect>.<parameter>`) from a string or a value, then checks its range."""
+    kind, where, what = _locate(cfg, key)
+    if kind == "effect":
+        cfg.params.effects.setdefault(where, {})[what["name"]] = _coerce(value, 0.0, key)
+        return
+    target, name = where, what
     setattr(target, name, _coerce(value, getattr(target, name), key))
-    check_field(target, fields[name], key)
+    check_field(target, _fields(target)[name], key)
     hook = getattr(target, "on_set", None)
     if hook is not None:
         hook(name)
@@ -125,24 +135,10 @@ def set_value(cfg, key: str, value: Any):
 def get_value(cfg, key: str) -> Any:
     """The value of `key` (the keys set_value() takes) in a configuration; an effect parameter of
     an effect that is not switched on reads as the parameter's neutral value (off)."""
-    parts = key.split(".")
-    if parts[0] == "effects" or (parts[0] == "params" and len(parts) > 1 and parts[1] == "effects"):
-        parts = parts[1:] if parts[0] == "params" else parts
-        if len(parts) == 3 and parts[2] in cfg.params.effects.get(parts[1], {}):
-            return cfg.params.effects[parts[1]][parts[2]]
-        from ..domain import effects as registry
-        spec = next((e for e in registry() if e["name"] == parts[1]), None)
-        param = next((q for q in (spec or {}).get("params", []) if len(parts) == 3 and q["name"] == parts[2]), None)
-        if param is None:
-            raise ConfigError(f"unknown key {key!r}")
-        return param["neutral"]
-    if parts[0] == "params" and len(parts) == 2:
-        return getattr(cfg.params, parts[1])
-    if len(parts) == 1 and parts[0] != "params" and parts[0] in _fields(cfg):
-        return getattr(cfg, parts[0])
-    if len(parts) == 1 and parts[0] in _fields(cfg.params):
-        return getattr(cfg.params, parts[0])
-    raise ConfigError(f"unknown key {key!r}")
+    kind, where, what = _locate(cfg, key)
+    if kind == "effect":
+        return cfg.params.effects.get(where, {}).get(what["name"], what["neutral"])
+    return getattr(where, what)
 
 
 def check_field(obj, f, key: str | None = None):
