@@ -23,6 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pydem.calibration.calibrate import calibrate  # noqa: E402
+from pydem.calibration.fit import Model  # noqa: E402
+from pydem.calibration.quantities import Observation  # noqa: E402
 from pydem.calibration.setup import load_setup, observations_from_file  # noqa: E402
 from pydem.measurements import load as load_measurements  # noqa: E402
 
@@ -33,12 +35,13 @@ RING_SHEAR_AT = {"preshear_stress": 2000.0, "shear_fraction": 0.6}
 
 
 def ring_shear_prediction(rs, theta: dict) -> dict:
-    """The ring-shear surrogates at the base parameters theta, candidates at neutral."""
-    values = dict(theta)
-    for c in rs.candidates:
-        values.setdefault(c.parameter, c.neutral_value(theta))
-    values.update(RING_SHEAR_AT)
-    out = {q.metric: float(net(np.array([[values[n] for n in net.input_names]]))[0]) for q, net in rs.nets.items()}
+    """The ring-shear surrogates at the base parameters theta, candidates at neutral (fit.Model's
+    own input assembly, as a prediction-only model)."""
+    obs = [Observation(q, {n: RING_SHEAR_AT[n] for n in net.input_names if n in RING_SHEAR_AT}, float("nan"), 0.0,
+                       q.key) for q, net in rs.nets.items()]
+    model = Model(obs, rs.nets, rs.ranges, rs.candidates)
+    values = model.predict(np.array([theta[n] for n in model.free]))
+    out = {o.quantity.metric: float(v) for o, v in zip(obs, values)}
     out["outside_box"] = [n for n, (lo, hi) in rs.ranges.items() if n in theta and not lo <= theta[n] <= hi]
     return out
 
