@@ -313,6 +313,12 @@ DEM_INLINE double effects_part(const pair_props *pp, const contact_in *c, const 
 
 /* ---- assembly --------------------------------------------------------------------------- */
 
+/* The force on i: the normal force along n plus the tangential force. */
+DEM_INLINE void contact_force(double fn, const double *n, const double *ft, double *force)
+{
+    for (int a = 0; a < 3; a++) force[a] = fn * n[a] + ft[a];
+}
+
 /* n x ft: the torque on body k is -(R_k - overlap/2) times it. */
 DEM_INLINE void tangential_cross(const double *n, const double *ft, double *cross)
 {
@@ -352,7 +358,7 @@ DEM_INLINE void contact_law(const pair_props *pp, const contact_in *c, double dt
         rolling_part(k.rolling_model, k.rolling, k.rolling_damping, c->n, c->wrel, &r, dt, mr_hist, out->mr);
     }
     const double fn_total = effects_part(pp, c, &no, vt, ft, out->mr);
-    for (int a = 0; a < 3; a++) out->force[a] = fn_total * c->n[a] + ft[a];
+    contact_force(fn_total, c->n, ft, out->force);
     tangential_cross(c->n, ft, out->cross);
 }
 

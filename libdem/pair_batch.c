@@ -25,17 +25,11 @@ int dem_takes_scalar_law(const pair_props *pp)
     return pp->n_effects > 0;
 }
 
-/* The rolling case of the batch: the one model of every contact that rolls, NONE, or MIXED. */
-static int batch_model(const pair_batch *b)
+/* The rolling case of a batch of per-contact constants, from the models of the contacts that roll
+ * (ROLL_NONE when none does, ROLL_MIXED when they differ): EPSD2 keeps its vectorised loop, a
+ * single other model takes the mixed loop (rare). */
+static int rolling_case_of(int model)
 {
-    if (b->uniform) return b->uniform->def.rolling_friction > 0.0 ? (int)b->uniform->def.rolling_model : ROLL_NONE;
-    int model = ROLL_NONE;
-    for (int q = 0; q < b->m; q++) {
-        if (!(b->rolling[q] > 0.0)) continue;
-        if (model == ROLL_NONE) model = b->model[q];
-        else if (model != b->model[q]) return ROLL_MIXED;
-    }
-    /* per-contact constants with one model other than EPSD2: the mixed loop (rare) */
     return model == ROLL_NONE || model == DEM_ROLLING_EPSD2 ? model : ROLL_MIXED;
 }
 
@@ -53,10 +47,10 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         const uint8_t sc = (uint8_t)dem_takes_scalar_law(b->uniform);
         if (sc) memset(b->scalar, 1, (size_t)m);
         b->any_scalar = sc;
-        b->rolling_case = batch_model(b);
+        b->rolling_case = b->uniform->def.rolling_friction > 0.0 ? (int)b->uniform->def.rolling_model : ROLL_NONE;
         return;
     }
-    int any = 0;
+    int any = 0, model = ROLL_NONE;
     for (int q = 0; q < m; q++) {
         const pair_props *pp = b->pp[q];
         b->e_star[q] = pp->e_star;
@@ -69,9 +63,11 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         b->model[q] = (int8_t)pp->def.rolling_model;
         b->scalar[q] = (uint8_t)dem_takes_scalar_law(pp);
         any |= b->scalar[q];
+        if (pp->def.rolling_friction > 0.0) /* the models of the contacts that roll */
+            model = model == ROLL_NONE || model == (int)pp->def.rolling_model ? (int)pp->def.rolling_model : ROLL_MIXED;
     }
     b->any_scalar = any;
-    b->rolling_case = batch_model(b);
+    b->rolling_case = rolling_case_of(model);
 }
 
 /* Contact q's constants in a batch with per-contact ones. */
@@ -171,13 +167,14 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
     for (int q = 0; q < m; q++) {
         const double n[3] = {s->n[0][q], s->n[1][q], s->n[2][q]}, fn = s->fn[q];
         const double ft[3] = {b->force[0][q], b->force[1][q], b->force[2][q]};
-        double mr[3] = {0.0, 0.0, 0.0}, cross[3], ti[3], tj[3];
+        double mr[3] = {0.0, 0.0, 0.0}, cross[3], ti[3], tj[3], f[3];
         if (model != ROLL_NONE)
             for (int a = 0; a < 3; a++) mr[a] = b->ti[a][q];
         tangential_cross(n, ft, cross);
         torques_from(cross, mr, s->ci[q], s->cj[q], ti, tj);
+        contact_force(fn, n, ft, f);
         for (int a = 0; a < 3; a++) {
-            b->force[a][q] = fn * n[a] + ft[a];
+            b->force[a][q] = f[a];
             b->ti[a][q] = ti[a];
             b->tj[a][q] = tj[a];
         }

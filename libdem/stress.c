@@ -84,7 +84,8 @@ static void add_contact(double *s, const double *f, const double *l)
 
 typedef struct contact_stress {
     const dem_region *g;
-    double *s; /* the contact part of the stress (9), volume not yet divided */
+    double *s;  /* the contact part of the stress (9), volume not yet divided */
+    int in_i;   /* whether the visited particle's centre is in the region */
 } contact_stress;
 
 /* One contact's share -f (x) l, l from the particle's centre to the contact point: a pair adds
@@ -94,7 +95,7 @@ static void add_visited(const dem_domain *d, const contact_view *c, void *ctx)
     const contact_stress *cs = ctx;
     const int64_t i = c->i;
     const double *xi = d->x + 3 * i;
-    const int in_i = inside(cs->g, xi);
+    const int in_i = cs->in_i;
     if (c->kind == DEM_CONTACT_PARTICLE) {
         const int in_j = inside(cs->g, d->x + 3 * (int64_t)c->j);
         const double *f = c->force, *n = c->n, r = c->dist; /* force on i */
@@ -144,10 +145,11 @@ dem_status dem_region_stress(dem_domain *d, const dem_region *g, dem_stress *out
     out->solid_fraction = solid / volume;
 
     double *sc = out->contact, *sk = out->kinetic;
-    contact_stress cs = {g, sc};
+    contact_stress cs = {g, sc, 0};
     for (int64_t i = 0; i < d->n; i++) {
+        cs.in_i = inside(g, d->x + 3 * i);
         dem_visit_contacts(d, i, VISIT_EVALUATED, add_visited, &cs);
-        if (!inside(g, d->x + 3 * i)) continue;
+        if (!cs.in_i) continue;
         const double m = 1.0 / d->inv_mass[i];
         double u[3];
         for (int a = 0; a < 3; a++) u[a] = d->v[3 * i + a] - out->mean_velocity[a];
