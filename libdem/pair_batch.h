@@ -24,11 +24,11 @@ typedef struct pair_batch_scratch {
     double kn[DEM_PAIR_BATCH], kt[DEM_PAIR_BATCH], gt[DEM_PAIR_BATCH], fn[DEM_PAIR_BATCH];
 } pair_batch_scratch;
 
+/* The arrays first, each a multiple of 64 bytes: every double array starts on a cache line
+ * when the batch does, so fewer vector loads of the stage loops straddle two lines (with the
+ * counts and flags first, the arrays sat at 8 mod 16 bytes: part of a 3-4 % loss on the
+ * packed bed, bench/README.md). */
 typedef struct pair_batch {
-    int m;                              /* contacts in the batch */
-    int any_scalar;
-    int rolling_case;                   /* set by dem_pair_batch_props (pair_batch.c) */
-    const pair_props *uniform;          /* every contact of this pair type: the constants below unset */
     /* gathered: list entry, partner, geometry and kinematics (i minus j). A batch of wall
      * contacts (dem_wall_batch_law) instead holds in dx, dy, dz the unit normal (towards the
      * sphere), in dist the centre-to-surface distance, in ri and imi the sphere's radius and
@@ -49,6 +49,10 @@ typedef struct pair_batch {
     /* results: force on i, torques on i and on j, overlap */
     double force[3][DEM_PAIR_BATCH], ti[3][DEM_PAIR_BATCH], tj[3][DEM_PAIR_BATCH], overlap[DEM_PAIR_BATCH];
     pair_batch_scratch s;
+    const pair_props *uniform;          /* every contact of this pair type: the constants above unset */
+    int m;                              /* contacts in the batch */
+    int any_scalar;
+    int rolling_case;                   /* set by dem_pair_batch_props (pair_batch.c) */
 } pair_batch;
 
 /* After the gather: the scalar flags, and either `uniform` (one pair type, the common case:

@@ -296,8 +296,12 @@ static int64_t open_rows(dem_domain *d, int64_t r0, int64_t r1)
 /* Phase 2: rows [r0, r1) in batches of list entries — gather, law, scatter in list order —
  * every row finished (direct) or parked (deferred) once the batch holding its end is done;
  * the mesh contacts of each block of MESH_ROWS rows evaluated before its first row finishes. */
-static void sweep_rows(const sweep_ctx *ctx, int64_t r0, int64_t r1, int tid, sweep_result *res)
+static void sweep_rows(const sweep_ctx *ctx_in, int64_t r0, int64_t r1, int tid, sweep_result *res_out)
 {
+    /* local copies: through the pointers, every store to a force array could alias the
+     * context's doubles (shifts, dt) and the result, and the compiler reloads them */
+    const sweep_ctx c = *ctx_in, *ctx = &c;
+    sweep_result r = *res_out, *res = &r;
     dem_domain *d = ctx->d;
     const double dt_hist = ctx->dt_hist;
     pair_batch b; /* ~29 KB on the thread's stack */
@@ -349,6 +353,7 @@ static void sweep_rows(const sweep_ctx *ctx, int64_t r0, int64_t r1, int tid, sw
         for (int a = 0; a < 6; a++) acc[0][a] = fin < cap ? acc[n_acc - 1][a] : 0.0;
         k = k1;
     }
+    *res_out = r;
 }
 
 /* Phase 3, after the barrier: the deferred particles (the first layer of each thread's rows:
