@@ -108,12 +108,14 @@ class Progress:
 
 
 def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray, y_val: np.ndarray, epochs: int = 20,
-        batch: int = 32, lr: float = 1e-4, seed: int = 0, checkpoint: str | Path | None = None, progress=None) -> dict:
+        batch: int = 32, lr: float = 1e-4, seed: int = 0, checkpoint: str | Path | None = None, progress=None,
+        scaling: dict | None = None) -> dict:
     """Trains model (in place, initialised by the caller: seed torch before building it) to
     predict y from x with MSE on standardised targets; keeps the weights of the best validation loss. With checkpoint (a file), the state after each epoch is
-    saved there and a rerun continues from it. Returns the history and the target scaling."""
+    saved there and a rerun continues from it. Returns the history and the target scaling
+    (`scaling`, e.g. a pretrained model's, is kept instead of the targets' own)."""
     torch.manual_seed(seed)
-    mean, sd = float(np.mean(y)), float(np.std(y) or 1.0)
+    mean, sd = (float(scaling["mean"]), float(scaling["sd"])) if scaling else (float(np.mean(y)), float(np.std(y) or 1.0))
     xt, yt = torch.from_numpy(np.ascontiguousarray(x)), torch.from_numpy(((y - mean) / sd).astype(np.float32))
     xv, yv = torch.from_numpy(np.ascontiguousarray(x_val)), torch.from_numpy(((y_val - mean) / sd).astype(np.float32))
     opt = torch.optim.Adam(model.parameters(), lr=lr)
@@ -163,13 +165,13 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
     return {"history": state["history"], "mean": mean, "sd": sd}
 
 
-def windows(x: np.ndarray, y: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
-    """Sliding windows of `length` consecutive frames (stride 1) for the CNN-LSTM:
-    (n - length + 1, length, 1, H, W) and their targets (n - length + 1, length)."""
+def windows(x: np.ndarray, y: np.ndarray, length: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Sliding windows of `length` consecutive frames, one starting every `stride` frames, for
+    the CNN-LSTM: (windows, length, 1, H, W) and their targets (windows, length)."""
     n = len(x) - length + 1
     if n < 1:
         raise ValueError(f"{len(x)} frames are fewer than one window of {length}")
-    idx = np.arange(length)[None, :] + np.arange(n)[:, None]
+    idx = np.arange(length)[None, :] + np.arange(0, n, stride)[:, None]
     return x[idx], y[idx]
 
 

@@ -109,7 +109,7 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
     sb.add_argument("--every", type=int, default=25)
     for name, what in (("compare", "AlexNet, ResNet-50, VGG-16, VGG-19 on the remaining discharge time"),
                        ("point-to-point", "AlexNet-FC, random-frame and leave-cases-out splits"),
-                       ("process", "the CNN-LSTM per case on NRRP(t) from its first 20 %%")):
+                       ("process", "the CNN-LSTM on each case's NRRP(t) beyond its first 20 %%")):
         e = sub.add_parser(name, help=what)
         e.add_argument("--store", required=True)
         e.add_argument("--out", required=True, help="directory for the results JSON and the training checkpoints")
@@ -118,6 +118,10 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         e.add_argument("--every", type=int, help="use every N-th stored frame (compare, point-to-point)")
         e.add_argument("--seed", type=int, default=0)
         e.add_argument("--threads", type=int, default=2, help="torch threads")
+        if name == "process":
+            e.add_argument("--protocol", choices=("pretrained", "per-case"), default="pretrained",
+                           help="pretrained: on other cases' whole discharges, fine-tuned on the case's first 20 %% "
+                                "(default); per-case: seed 001's, the first 20 %% only")
     rp = sub.add_parser("report", help="HTML + Markdown report of the GRA and the experiments' results")
     rp.add_argument("--store", required=True)
     rp.add_argument("--results", required=True, help="the experiments' --out directory")
@@ -140,6 +144,7 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         kw = {k: v for k, v in (("epochs", args.epochs), ("every", args.every)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
+            kw["protocol"] = args.protocol
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
         run(args.store, args.out, size=args.size, seed=args.seed, **kw)
         return 0

@@ -6,8 +6,9 @@
 - `point_to_point`: AlexNet-FC on two splits — random frames (the seed's protocol; neighbouring
   frames of one run are near-duplicates, so it flatters) and leave-cases-out (whole cases held
   out: a new hopper); R^2 and average relative error per packing pattern;
-- `process`: the CNN-LSTM per case, trained on the first 20 % of its time-ordered frames,
-  predicting NRRP over the rest; average relative error per packing pattern.
+- `process`: the CNN-LSTM predicting each case's NRRP beyond the first 20 % of its
+  time-ordered frames — trained on those frames only (seed 001's protocol), or pretrained on
+  other cases' whole discharges and fine-tuned on them; average relative error per packing.
 
 Baselines: the remaining discharge time as the frame's fill fraction (image-only NRRP
 estimate) times Beverloo's discharge time (C, k fitted on the training cases); NRRP by a
@@ -123,41 +124,111 @@ def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12,
     return res
 
 
-def process(store, out, size: int = 64, window: int = 8, epochs: int = 40, lr: float = 1e-3, seed: int = 0,
-            fraction: float = 0.2, say=print) -> dict:
-    """Per case: the CNN-LSTM trained on windows of the first `fraction` of its frames (the
-    last of them for validation), then each later frame's NRRP read from the window that ends
-    at it."""
+def _fold(case: str) -> str:
+    """A case's fold for leave-cases-out: its index within its packing (A-3 -> "3")."""
+    return case.rsplit("-", 1)[1]
+
+
+def _nrrp_windows(f: images.Frames, window: int, stride: int = 1):
+    return images.windows(f.x, f.nrrp.astype(np.float32), window, stride)
+
+
+def _read_later(model, f: images.Frames, k: int, window: int, scaling: dict) -> np.ndarray:
+    """The NRRP of every frame from k on, read from the window of `window` frames ending there."""
+    xr, _ = images.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
+    return np.clip(images.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
+
+
+def _window_mse(model, xw, yw, scaling: dict) -> float:
+    return float(np.mean((images.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
+
+
+def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 1e-3, seed: int = 0,
+            fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
+            say=print) -> dict:
+    """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
+
+    protocol "per-case" (seed 001's): the CNN-LSTM trained on windows of the case's first
+    `fraction` of frames only (`epochs`, default 40; the last fifth of them for validation).
+    protocol "pretrained": cases in five folds by their index within the packing (A-1, B1-1 ...
+    in fold 1); for each fold the CNN-LSTM is trained on the whole sequences of three other folds
+    (windows every `stride` frames; `epochs`, default 8), validated on the fourth, and then, for
+    each of the fold's cases, fine-tuned on windows of that case's first `fraction` (lr / 10,
+    `finetune_epochs`), the fine-tuned weights kept only where they lower the error on the
+    case's own held-back early windows. The zero-shot prediction (no frame of the case seen) is
+    reported beside it. In both, each later frame's NRRP is read from the window ending at it."""
     from pydem.frames import FrameStore
+    if protocol not in ("pretrained", "per-case"):
+        raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
+    epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
-    res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction},
+    res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
+                        "protocol": protocol} | ({"stride": stride, "finetune_epochs": finetune_epochs,
+                                                  "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
            "machine": _machine(), "cases": {}}
-    for case in FrameStore(store).cases():
-        f = images.load_frames(store, cases=[case], size=size)
+    cases = FrameStore(store).cases()
+    data = {c: images.load_frames(store, cases=[c], size=size) for c in cases}
+    folds = sorted({_fold(c) for c in cases})
+    pretrained = {}
+    if protocol == "pretrained":
+        if len(folds) < 3:
+            raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
+        for i, fold in enumerate(folds):
+            val_fold = folds[(i + 1) % len(folds)]
+            pick = lambda which: [_nrrp_windows(data[c], window, stride) for c in cases  # noqa: E731
+                                  if which(_fold(c)) and len(data[c].x) >= window]
+            tr = pick(lambda fd: fd not in (fold, val_fold))
+            va = pick(lambda fd: fd == val_fold)
+            xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
+            xv, yv = np.concatenate([a for a, _ in va]), np.concatenate([b for _, b in va])
+            say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
+                f"(validation: fold {val_fold}, {len(xv)} windows)")
+            torch.manual_seed(seed)
+            model = cnn.CNNLSTM()
+            t0 = time.perf_counter()
+            scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed,
+                                 checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=images.Progress(say))
+            pretrained[fold] = (model, scaling, time.perf_counter() - t0)
+    for case in cases:
+        f = data[case]
         k = max(window + 2, int(round(fraction * len(f.x))))
         if len(f.x) < k + window:
             say(f"  {case}: {len(f.x)} frames, too few for windows of {window}; skipped")
             continue
         xw, yw = images.windows(f.x[:k], f.nrrp[:k].astype(np.float32), window)
         n_val = max(1, len(xw) // 5)
-        torch.manual_seed(seed)
-        model = cnn.CNNLSTM()
+        row = {"frames": int(len(f.x)), "trained_on": int(k)}
         t0 = time.perf_counter()
-        scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8, lr=lr,
-                             seed=seed, checkpoint=out / f"lstm_{case}.pt")
-        seconds = time.perf_counter() - t0
-        xr, _ = images.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
-        pred = np.clip(images.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
+        if protocol == "per-case":
+            torch.manual_seed(seed)
+            model = cnn.CNNLSTM()
+            scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
+                                 lr=lr, seed=seed, checkpoint=out / f"lstm_{case}.pt")
+        else:
+            base_model, scaling, pre_seconds = pretrained[_fold(case)]
+            row["zero_shot"] = images.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
+            model = cnn.CNNLSTM()
+            model.load_state_dict(base_model.state_dict())
+            images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
+                       lr=lr / 10, seed=seed, checkpoint=out / f"lstm_finetune_{case}.pt", scaling=scaling)
+            before, after = (_window_mse(m, xw[-n_val:], yw[-n_val:], scaling) for m in (base_model, model))
+            row["finetune_kept"] = bool(after < before)
+            if not row["finetune_kept"]:
+                model = base_model
+            row["pretrain_seconds"] = pre_seconds
+        row["train_seconds"] = time.perf_counter() - t0
+        pred = _read_later(model, f, k, window, scaling)
         truth = f.nrrp[k:]
         base = images.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
-        res["cases"][case] = {"frames": int(len(f.x)), "trained_on": int(k), "train_seconds": seconds,
-                              "net": images.scores(truth, pred), "baseline": images.scores(truth, base),
-                              "time": f.time[k:].tolist(), "nrrp": truth.tolist(), "predicted": pred.tolist(),
-                              "baseline_nrrp": base.tolist()}
-        say(f"  {case}: relative error {res['cases'][case]['net']['relative_error']:.3f} "
-            f"(constant rate {res['cases'][case]['baseline']['relative_error']:.3f}), {seconds:.0f} s")
-    res["per_packing"] = {pk: {"net": float(np.mean([r["net"]["relative_error"] for c, r in res["cases"].items() if _packing(c) == pk])),
-                               "baseline": float(np.mean([r["baseline"]["relative_error"] for c, r in res["cases"].items() if _packing(c) == pk]))}
+        row |= {"net": images.scores(truth, pred), "baseline": images.scores(truth, base), "time": f.time[k:].tolist(),
+                "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": base.tolist()}
+        res["cases"][case] = row
+        say(f"  {case}: relative error {row['net']['relative_error']:.3f} "
+            + (f"(zero-shot {row['zero_shot']['relative_error']:.3f}) " if "zero_shot" in row else "")
+            + f"(constant rate {row['baseline']['relative_error']:.3f})")
+    keys = ("net", "baseline") + (("zero_shot",) if protocol == "pretrained" else ())
+    res["per_packing"] = {pk: {key: float(np.mean([r[key]["relative_error"] for c, r in res["cases"].items()
+                                                   if _packing(c) == pk])) for key in keys}
                           for pk in PACKINGS if any(_packing(c) == pk for c in res["cases"])}
     _save(out / "process.json", res)
     return res

@@ -106,8 +106,11 @@ def point_to_point_section(res: dict, plots: dict):
 def process_section(res: dict, plots: dict):
     from pydem.calibration.report import _png, _table
     import matplotlib.pyplot as plt
-    rows = [[pk, _f(v["net"]), _f(v["baseline"])] for pk, v in res["per_packing"].items()]
-    md, h = _table(rows, ["packing", "CNN-LSTM relative error", "constant-rate relative error"])
+    zero = any("zero_shot" in v for v in res["per_packing"].values())
+    rows = [[pk, _f(v["net"])] + ([_f(v["zero_shot"])] if zero else []) + [_f(v["baseline"])]
+            for pk, v in res["per_packing"].items()]
+    md, h = _table(rows, ["packing", "CNN-LSTM relative error"] + (["zero-shot (no frame of the case)"] if zero else [])
+                   + ["constant-rate relative error"])
     fig, axes = plt.subplots(1, 5, figsize=(13, 2.8), sharey=True)
     for ax, pk in zip(axes, ("A", "B1", "B2", "B3", "B4")):
         cases = [c for c in res["cases"] if c.split("-")[0] == pk]
@@ -123,8 +126,12 @@ def process_section(res: dict, plots: dict):
     axes[0].legend(fontsize=7)
     plots["nrrp.png"] = _png(fig)
     st = res["settings"]
-    line = (f"Per case: trained on the first {st['fraction']:.0%} of its frames (windows of {st['window']}), "
-            f"{st['epochs']} epochs, frames {st['size']} x {st['size']}. Seed 001: {SEED_LSTM}.")
+    if st.get("protocol", "per-case") == "pretrained":
+        how = (f"Pretrained on other cases' whole discharges (leave-fold-out, {st['epochs']} epochs), fine-tuned on "
+               f"each case's first {st['fraction']:.0%} ({st['finetune_epochs']} epochs)")
+    else:
+        how = f"Per case: trained on the first {st['fraction']:.0%} of its frames, {st['epochs']} epochs"
+    line = f"{how}; windows of {st['window']}, frames {st['size']} x {st['size']}. Seed 001: {SEED_LSTM}."
     return "CNN-LSTM process prediction (NRRP)", line + "\n\n" + md, f"<p>{line}</p>" + h
 
 

@@ -59,7 +59,29 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert set(lco["test"]["case"]) == set(p2p["settings"]["test_cases"])  # whole cases held out
     proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, say=lambda *a: None)
     assert set(proc["per_packing"]) == {"A", "B1", "B2", "B3", "B4"}
+    assert proc["settings"]["protocol"] == "pretrained"
+    assert all(set(v) == {"net", "baseline", "zero_shot"} for v in proc["per_packing"].values())
+    assert all(isinstance(r["finetune_kept"], bool) for r in proc["cases"].values())
     page = write(SUBSET, tmp_path, tmp_path / "report")
     text = page.read_text()
     assert "Grey relational analysis" in text and "AlexNet-FC point to point" in text and "data:image/png;base64," in text
     assert json.loads((tmp_path / "process.json").read_text())["settings"]["window"] == 2
+
+
+def test_windows_with_a_stride_start_every_stride_frames():
+    import numpy as np
+    from nn.images import windows
+    x = np.arange(10, dtype=np.float32).reshape(10, 1, 1, 1)
+    xw, yw = windows(x, np.arange(10.0), 4, stride=3)
+    assert xw.shape == (3, 4, 1, 1, 1) and yw[:, 0].tolist() == [0.0, 3.0, 6.0] and yw[-1].tolist() == [6, 7, 8, 9]
+
+
+def test_fit_keeps_a_given_target_scaling():
+    import numpy as np
+    import torch
+    from nn.images import fit
+    torch.manual_seed(0)
+    model = torch.nn.Linear(1, 1)
+    x = np.linspace(0, 1, 16, dtype=np.float32).reshape(-1, 1)
+    s = fit(model, x, 2 * x[:, 0], x, 2 * x[:, 0], epochs=1, batch=8, scaling={"mean": 5.0, "sd": 3.0})
+    assert (s["mean"], s["sd"]) == (5.0, 3.0)
