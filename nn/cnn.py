@@ -160,12 +160,28 @@ class CNNLSTM(nn.Module):
             self.lstms.append(nn.LSTM(width, u, batch_first=True))
             width = u
         self.out = nn.Linear(width, 1)
+        # He initialisation of the convolutions and the 1024 map (torch's default shrinks the
+        # signal ~2x per layer; behind four small LSTMs the output then hardly depends on the
+        # frames, and training stalled at the targets' mean), and each LSTM's forget gate
+        # biased open (+1), the usual remedy for a stack of them
+        for m in self.modules():
+            if isinstance(m, (nn.Conv2d, nn.Linear)) and m is not self.out:
+                nn.init.kaiming_normal_(m.weight, mode="fan_in", nonlinearity="relu")
+                nn.init.zeros_(m.bias)
+        for lstm in self.lstms:
+            h = lstm.hidden_size
+            nn.init.xavier_uniform_(lstm.weight_ih_l0)  # gates not saturated by the 1024 inputs
+            nn.init.orthogonal_(lstm.weight_hh_l0)
+            with torch.no_grad():
+                lstm.bias_ih_l0[h:2 * h].fill_(1.0)
+                lstm.bias_hh_l0[h:2 * h].zero_()
 
     min_input = 16  # four 2/2 max pools
 
     def forward(self, frames):
         b, t = frames.shape[:2]
-        z = self.cnn(frames.reshape(b * t, *frames.shape[2:])).reshape(b, t, -1)
+        # particles bright on a dark background: the frames are dark spheres on white
+        z = self.cnn(1.0 - frames.reshape(b * t, *frames.shape[2:])).reshape(b, t, -1)
         for lstm in self.lstms:
             z, _ = lstm(z)
         return self.out(z).squeeze(-1)
