@@ -109,11 +109,12 @@ class Progress:
 
 def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray, y_val: np.ndarray, epochs: int = 20,
         batch: int = 32, lr: float = 1e-4, seed: int = 0, checkpoint: str | Path | None = None, progress=None,
-        scaling: dict | None = None) -> dict:
+        scaling: dict | None = None, clip: float | None = None) -> dict:
     """Trains model (in place, initialised by the caller: seed torch before building it) to
     predict y from x with MSE on standardised targets; keeps the weights of the best validation loss. With checkpoint (a file), the state after each epoch is
     saved there and a rerun continues from it. Returns the history and the target scaling
-    (`scaling`, e.g. a pretrained model's, is kept instead of the targets' own)."""
+    (`scaling`, e.g. a pretrained model's, is kept instead of the targets' own); `clip`: the
+    gradient's largest norm per step (recurrent networks: one large step can collapse them)."""
     torch.manual_seed(seed)
     mean, sd = (float(scaling["mean"]), float(scaling["sd"])) if scaling else (float(np.mean(y)), float(np.std(y) or 1.0))
     xt, yt = torch.from_numpy(np.ascontiguousarray(x)), torch.from_numpy(((y - mean) / sd).astype(np.float32))
@@ -123,6 +124,8 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
     ck = Path(checkpoint) if checkpoint else None
     signature = {"model": type(model).__name__, "parameters": sum(p.numel() for p in model.parameters()),
                  "x": list(np.shape(x)), "x_val": list(np.shape(x_val)), "batch": batch, "lr": lr, "seed": seed}
+    if clip is not None:
+        signature["clip"] = clip
     if ck is not None and ck.exists():
         saved = torch.load(ck, weights_only=False)
         if saved.get("signature") != signature:
@@ -141,6 +144,8 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
             opt.zero_grad()
             loss = torch.mean((model(xt[idx]).reshape(yt[idx].shape) - yt[idx]) ** 2)
             loss.backward()
+            if clip is not None:
+                torch.nn.utils.clip_grad_norm_(model.parameters(), clip)
             opt.step()
             total += float(loss.detach()) * len(idx)
             seen += len(idx)

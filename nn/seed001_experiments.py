@@ -27,6 +27,7 @@ import torch
 from . import cnn, images
 
 PACKINGS = ("A", "B1", "B2", "B3", "B4")
+LSTM_CLIP = 1.0  # gradient norm cap of the CNN-LSTM's steps: unclipped, a pretraining at lr 1e-3 collapsed to the mean
 
 
 def _packing(case: str) -> str:
@@ -163,7 +164,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
     res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
-                        "protocol": protocol} | ({"stride": stride, "finetune_epochs": finetune_epochs,
+                        "protocol": protocol, "gradient_clip": LSTM_CLIP} | ({"stride": stride, "finetune_epochs": finetune_epochs,
                                                   "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
            "machine": _machine(), "cases": {}}
     cases = FrameStore(store).cases()
@@ -186,7 +187,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             torch.manual_seed(seed)
             model = cnn.CNNLSTM()
             t0 = time.perf_counter()
-            scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed,
+            scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
                                  checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=images.Progress(say))
             pretrained[fold] = (model, scaling, time.perf_counter() - t0)
     for case in cases:
@@ -203,14 +204,15 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             torch.manual_seed(seed)
             model = cnn.CNNLSTM()
             scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
-                                 lr=lr, seed=seed, checkpoint=out / f"lstm_{case}.pt")
+                                 lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
         else:
             base_model, scaling, pre_seconds = pretrained[_fold(case)]
             row["zero_shot"] = images.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
             model = cnn.CNNLSTM()
             model.load_state_dict(base_model.state_dict())
             images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
-                       lr=lr / 10, seed=seed, checkpoint=out / f"lstm_finetune_{case}.pt", scaling=scaling)
+                       lr=lr / 10, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_finetune_{case}.pt",
+                       scaling=scaling)
             before, after = (_window_mse(m, xw[-n_val:], yw[-n_val:], scaling) for m in (base_model, model))
             row["finetune_kept"] = bool(after < before)
             if not row["finetune_kept"]:
