@@ -27,7 +27,7 @@ import torch
 from . import cnn, images
 
 PACKINGS = ("A", "B1", "B2", "B3", "B4")
-LSTM_CLIP = 1.0  # gradient norm cap of the CNN-LSTM's steps: unclipped, a pretraining at lr 1e-3 collapsed to the mean
+LSTM_CLIP = 1.0  # gradient norm cap of the CNN-LSTM's steps (recurrent layers)
 
 
 def _packing(case: str) -> str:
@@ -144,7 +144,7 @@ def _window_mse(model, xw, yw, scaling: dict) -> float:
     return float(np.mean((images.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
 
 
-def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 1e-3, seed: int = 0,
+def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
             say=print) -> dict:
     """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
