@@ -16,6 +16,7 @@ constant-rate extrapolation of the first 20 %. Every result records its settings
 training took and the machine, so the docs' tables can say what stands behind them."""
 from __future__ import annotations
 
+import copy
 import json
 import platform
 import time
@@ -174,12 +175,11 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     if protocol == "pretrained":
         if len(folds) < 3:
             raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
+        whole = {c: _nrrp_windows(data[c], window, stride) for c in cases if len(data[c].x) >= window}
         for i, fold in enumerate(folds):
             val_fold = folds[(i + 1) % len(folds)]
-            pick = lambda which: [_nrrp_windows(data[c], window, stride) for c in cases  # noqa: E731
-                                  if which(_fold(c)) and len(data[c].x) >= window]
-            tr = pick(lambda fd: fd not in (fold, val_fold))
-            va = pick(lambda fd: fd == val_fold)
+            tr = [w for c, w in whole.items() if _fold(c) not in (fold, val_fold)]
+            va = [w for c, w in whole.items() if _fold(c) == val_fold]
             xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
             xv, yv = np.concatenate([a for a, _ in va]), np.concatenate([b for _, b in va])
             say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
@@ -196,7 +196,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         if len(f.x) < k + window:
             say(f"  {case}: {len(f.x)} frames, too few for windows of {window}; skipped")
             continue
-        xw, yw = images.windows(f.x[:k], f.nrrp[:k].astype(np.float32), window)
+        xw, yw = _nrrp_windows(f.take(slice(None, k)), window)
         n_val = max(1, len(xw) // 5)
         row = {"frames": int(len(f.x)), "trained_on": int(k)}
         t0 = time.perf_counter()
@@ -208,8 +208,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         else:
             base_model, scaling, pre_seconds = pretrained[_fold(case)]
             row["zero_shot"] = images.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
-            model = cnn.CNNLSTM()
-            model.load_state_dict(base_model.state_dict())
+            model = copy.deepcopy(base_model)
             images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
                        lr=lr / 10, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_finetune_{case}.pt",
                        scaling=scaling)
