@@ -131,12 +131,11 @@ bench: setup lib $(BENCH_BIN)
 # then the diagnosis loop: a synthetic material made by our rigs with a hidden effect (the loop
 # must find it), and the glass microbeads (build/diagnosis)
 # the synthetic material was made by the tiny rigs: it is diagnosed with the tiny stores
-TINY_STORES := data/campaigns/diag_ring_shear_tiny.h5 data/campaigns/diag_aor_tiny.h5 data/campaigns/diag_hopper_tiny.h5
 demo: setup lib
 	@$(MAKE) --no-print-directory pydem
 	.venv/bin/pydem calibrate data/measurements/glass_microbeads.csv --material glass_microbeads --out $(BUILD)/calibration
 	.venv/bin/pydem diagnose data/measurements/synthetic_cohesive.csv --material synthetic_cohesive \
-	  --stores $(TINY_STORES) --out $(BUILD)/diagnosis/synthetic_cohesive
+	  --out $(BUILD)/diagnosis/synthetic_cohesive
 	.venv/bin/pydem diagnose data/measurements/glass_microbeads.csv --material glass_microbeads \
 	  --out $(BUILD)/diagnosis/glass_microbeads
 

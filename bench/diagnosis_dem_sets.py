@@ -91,7 +91,10 @@ def diagnose(args):
                 and r["rig"] not in args.skip_rigs]  # rows of the given stores' rigs only
         obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
         vals = {i: r["value"] for i, r in enumerate(kept)}
-        noisy = synthetic.with_lab_noise(obs, vals, setup.nets, rng)
+        t = row["truth"]
+        truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
+        noisy = synthetic.with_lab_noise(obs, vals, setup.nets, rng,
+                                         synthetic.row_inputs(setup.nets, setup.candidates, truth, obs))
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,

@@ -4,10 +4,18 @@ plus lab noise (pydem.calibration.synthetic). The truth goes into the file's com
 
     .venv/bin/python scripts/make_synthetic_material.py --effect cohesion_sjkr --strength 6e4 \\
         --name synthetic_cohesive --out data/measurements/synthetic_cohesive.csv
+
+or from a set that bench/diagnosis_dem_sets.py already ran (its journal keeps the rigs' raw
+values and the truth; only the lab noise is drawn here):
+
+    .venv/bin/python scripts/make_synthetic_material.py --journal bench/results/dem_sets_default.jsonl \\
+        --set 1 --preset default --name synthetic_cohesive --out data/measurements/synthetic_cohesive.csv
 """
 from __future__ import annotations
 
 import argparse
+import json
+import math
 import sys
 from pathlib import Path
 
@@ -30,15 +38,28 @@ def main() -> int:
     ap.add_argument("--out", required=True)
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--journal", help="take the rigs' values and the truth from this diagnosis_dem_sets.py journal")
+    ap.add_argument("--set", type=int, default=0, help="the journal's line (0-based)")
     a = ap.parse_args()
     stores = [ROOT / f"data/campaigns/diag_{r}_{a.preset}.h5" for r in ("ring_shear", "aor", "hopper")]
     setup = load_setup([s for s in stores if s.exists()])
-    theta = {k: float(v) for k, v in (kv.split("=") for kv in a.theta.split(","))}
-    cand = next((c for c in setup.candidates if c.name == a.effect), None) if a.effect else None
-    truth = synthetic.Truth(theta, a.effect, cand.parameter if cand else None, a.strength)
     rng = np.random.default_rng(a.seed)
-    obs = synthetic.dem_set(setup.stores, setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets),
-                            seed=a.seed, threads=a.threads)
+    if a.journal:
+        from pydem.calibration.quantities import Observation, Quantity
+        row = json.loads(Path(a.journal).read_text().splitlines()[a.set])
+        t = row["truth"]
+        truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
+        kept = [r for r in row["rows"] if r["value"] is not None]
+        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
+        obs = synthetic.with_lab_noise(obs, {i: r["value"] for i, r in enumerate(kept)}, setup.nets, rng,
+                                       synthetic.row_inputs(setup.nets, setup.candidates, truth, obs))
+        a.effect, a.strength = truth.effect, truth.strength
+    else:
+        theta = {k: float(v) for k, v in (kv.split("=") for kv in a.theta.split(","))}
+        cand = next((c for c in setup.candidates if c.name == a.effect), None) if a.effect else None
+        truth = synthetic.Truth(theta, a.effect, cand.parameter if cand else None, a.strength)
+        obs = synthetic.dem_set(setup.stores, setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets),
+                                seed=a.seed, threads=a.threads)
     note = (f"SYNTHETIC material '{a.name}': made by pydem's own rigs (preset {a.preset}) with "
             + (f"{a.effect} = {a.strength:g} switched on" if a.effect else "no hidden effect")
             + f", lab noise added (2 % friction coefficients, 1 % bulk density, 0.5 deg angle, 2 % hopper); "

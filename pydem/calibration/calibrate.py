@@ -70,7 +70,7 @@ def weak_surrogates(observations: list[Observation], nets: dict) -> list[str]:
         n = nets[q]
         r2 = getattr(n, "r2", 1.0)
         if r2 < WEAK_R2:
-            out.append(f"the surrogate of {q.key} explains little of its {getattr(n, 'runs', '?')} runs (hold-out R² "
+            out.append(f"the surrogate of {q.key} explains little of its {getattr(n, 'runs', '?')} runs (cross-validated R² "
                        f"{r2:.2f}, RMSE {n.rmse:.3g}): what this quantity says about the parameters is mostly lost in "
                        f"its uncertainty, and the posterior stays near the prior; more runs in its store are needed")
     return out
@@ -100,9 +100,13 @@ def fit_summary(model: Model, fit: Fit) -> dict:
 
 
 def fit_base(observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate]) -> tuple[Model, Fit]:
-    """The base model (candidates at their neutral values) fitted, with its posterior."""
+    """The base model (candidates at their neutral values) fitted, with its posterior. Two
+    passes: with the nets' pooled errors, then with their error models at that fit's parameters
+    (fit.Model's `at`), started from the first optimum."""
     model = Model(observations, nets, ranges, candidates)
     fit = minimise(model)
+    model = Model(observations, nets, ranges, candidates, at=fit.best)
+    fit = minimise(model, start=fit.best)
     fit.posterior = posterior(model, fit)
     return model, fit
 

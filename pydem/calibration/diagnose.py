@@ -216,8 +216,11 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         if c.side == "+" and step < 0:  # one-sided: a step to unphysical values scores nothing
             s = 0.0
         mjs[c.name] = mje
-        m = Model(observations, nets, ranges, covered, c)
-        f = minimise(m, start=np.append(base.best, c.neutral_value(base.as_dict())))
+        # the base fit's noise model (at = the base optimum, the candidate neutral): LR compares
+        # two chi^2 of one quadratic form
+        at = np.append(base.best, c.neutral_value(base.as_dict()))
+        m = Model(observations, nets, ranges, covered, c, at=at)
+        f = minimise(m, start=at)
         lr = max(base.chi2 - f.chi2, 0.0)
         neutral = c.neutral_value(base.as_dict())
         p = float(stats.chi2.sf(lr, 1))
@@ -248,8 +251,11 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
             separating[f"{chosen.effect}|{r.effect}"] = _separating(pool, nets, ranges, covered, chosen, r)
     if chosen is not None:
         cand = next(c for c in covered if c.parameter == chosen.parameter)
-        after_model = Model(observations, nets, ranges, covered, cand)
-        after = chosen.fit
+        # the effect's fit judged with the noise model where it lands (a cohesive material's runs
+        # scatter more than a free-flowing one's)
+        after_model = Model(observations, nets, ranges, covered, cand, at=chosen.fit.best)
+        after = minimise(after_model, start=chosen.fit.best)
+        chosen.fit = after
         after.posterior = posterior(after_model, after)
         p = after.posterior["parameters"][cand.parameter]
         chosen.estimate_lo, chosen.estimate_hi = p["lo"], p["hi"]

@@ -38,7 +38,7 @@ NET_ERROR_LENGTH = 1.0
 
 class Model:
     def __init__(self, observations: list[Observation], nets: dict, ranges: dict[str, tuple[float, float]],
-                 candidates: list[Candidate], free_candidate: Candidate | None = None):
+                 candidates: list[Candidate], free_candidate: Candidate | None = None, at: np.ndarray | None = None):
         self.obs = observations
         self.nets = [nets[o.quantity] for o in observations]
         self.candidates = {c.parameter: c for c in candidates}
@@ -47,9 +47,27 @@ class Model:
         self.lo = np.array([ranges[n][0] for n in self.free])
         self.hi = np.array([ranges[n][1] for n in self.free])
         self.y = np.array([o.value for o in observations])
-        self.sigma = np.array([n.row_sigma(o.uncertainty) for o, n in zip(observations, self.nets)])
         self._whiten = None  # L^-1, made on first use (a model only asked for predictions needs no noise)
         self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
+        self.at = None if at is None else np.asarray(at, dtype=float)
+        self._seed, self._err, self.sigma = self._row_errors()
+
+    def _row_errors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Each row's seed scatter, net error and marginal sd: the nets' error models at the row's
+        inputs for the parameters `at` (the noise model is then fixed for this Model: chi^2 stays
+        a quadratic form, and models compared by their chi^2 share it), or their pooled values
+        (QuantityNet.row_sigma: a measured value scatters at least as much as one rig run)."""
+        n_rows = len(self.obs)
+        seed, err, sigma = np.zeros(n_rows), np.zeros(n_rows), np.zeros(n_rows)
+        for k, (o, n) in enumerate(zip(self.obs, self.nets)):
+            if self.at is not None and hasattr(n, "errors_at"):
+                a, b = n.errors_at(self.row_inputs(k, self.at))
+                seed[k], err[k] = a[0], b[0]
+                sigma[k] = np.sqrt(max(o.uncertainty, seed[k]) ** 2 + err[k] ** 2)
+            else:
+                seed[k], err[k] = getattr(n, "seed_sd", 0.0), getattr(n, "net_error", 0.0)
+                sigma[k] = n.row_sigma(o.uncertainty)
+        return seed, err, sigma
 
     @property
     def cov(self) -> np.ndarray:
@@ -66,8 +84,7 @@ class Model:
     def _covariance(self) -> np.ndarray:
         """Rows' noise covariance: independent scatter plus the nets' errors, correlated over
         the conditions within one quantity (module docstring)."""
-        e = np.array([getattr(n, "net_error", 0.0) for n in self.nets])
-        s = np.array([getattr(n, "seed_sd", 0.0) for n in self.nets])
+        e, s = self._err, self._seed
         cov = np.diag(self.sigma ** 2 - e ** 2)
         for i, (oi, ni) in enumerate(zip(self.obs, self.nets)):
             for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):

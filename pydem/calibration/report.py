@@ -132,12 +132,12 @@ def plot_parameters(fit, window: dict | None) -> bytes:
 
 
 def nets_section(nets: dict) -> tuple[str, str, str]:
-    """The surrogates' quality: hold-out R^2 and RMSE against single runs, and how that RMSE
+    """The surrogates' quality: cross-validated R^2 and RMSE against single runs, and how that RMSE
     splits into the rig's seed scatter and the net's own error (docs/diagnosis.md §3)."""
     rows = [[q.key, n.runs, ", ".join(x.split(".")[-1] for x in n.input_names), _g(n.r2, ".3f"), _g(n.rmse, ".3g"),
              _g(n.seed_sd, ".3g") + ("" if math.isfinite(n.scatter) else " (all of the RMSE)"), _g(n.net_error, ".3g")]
             for q, n in sorted(nets.items(), key=lambda kv: kv[0].key)]
-    md, h = _table(rows, ["quantity", "rows", "inputs", "hold-out R²", "hold-out RMSE", "seed scatter", "net error"])
+    md, h = _table(rows, ["quantity", "rows", "inputs", "CV R²", "CV RMSE", "seed scatter", "net error"])
     return "Surrogates", md, h
 
 

@@ -1,12 +1,14 @@
 """Surrogates that know conditions and effects: one net per Quantity, f(theta, eta, x).
 
-Trained once per campaign store (nn.mlp.select_net: tanh MLP, SCG, hidden size by the one-SE
-rule on a 15 % hold-out) and cached next to the store as plain arrays (`<store>.nets/`, keyed by
+Trained once per campaign store (nn.mlp.bagged_net: the mean of BAG tanh MLPs trained with SCG
+on all runs, itself one wider net; the members' hidden size the one of SIZES with the lowest
+FOLDS-fold cross-validated RMSE) and cached next to the store as plain arrays (`<store>.nets/`, keyed by
 a hash of the store's runs), so a diagnosis loads them in milliseconds and gets the same
 numbers on every machine. Evaluation and Jacobians are numpy (one hidden layer: the Jacobian
 is analytic).
 
-Each net's error model is its hold-out RMSE against single runs: the rig's seed-to-seed
+Each net's error model is its cross-validated RMSE against single runs (FOLDS folds, one run's
+rows in one fold): the rig's seed-to-seed
 scatter and the net's own error together, which is what separates one DEM run (or one lab
 repeat) from the surrogate's smooth mean; the diagnosis adds it to every row's measurement
 uncertainty. A quantity measured at several points of one test (the shear points of one
@@ -24,9 +26,11 @@ import numpy as np
 
 from .quantities import Quantity, fraction_columns, training_tables
 
-NET_FORMAT = 1
-SIZES = (3, 6, 10, 16, 24)
-RESTARTS = 2
+NET_FORMAT = 2  # 2: bagged nets with an error model (a cache of format 1 is retrained)
+SIZES = (3, 6, 10, 16)  # hidden units per bagged member, chosen by the cross-validated RMSE
+BAG = 4     # nets averaged per quantity (nn.mlp.bagged_net)
+FOLDS = 5   # cross-validation folds for the error model
+ERROR_SPAN = 5.0  # the error model's sd stays within [RMSE / 5, RMSE * 5]
 
 
 @dataclass
@@ -41,22 +45,26 @@ class QuantityNet:
     b1: np.ndarray
     w2: np.ndarray          # hidden
     b2: float
-    rmse: float             # hold-out RMSE against single runs (scatter + net error)
-    r2: float               # hold-out R^2
+    rmse: float             # cross-validated RMSE against single runs (scatter + net error)
+    r2: float               # cross-validated R^2
     runs: int
     unit: str = ""
     scatter: float = float("nan")  # seed-to-seed sd of one run, from replicate runs (nan: unknown)
     test_correlation: float = 0.0  # correlation of one run's errors at its several points (shear points)
+    # where the error is: log sd of one run about the net = err_c0 + err_c . (scaled inputs), fitted
+    # to the cross-validated residuals (fit_error_model); None: the RMSE everywhere
+    err_c0: float = float("nan")
+    err_c: np.ndarray | None = None
 
     @property
     def seed_sd(self) -> float:
-        """One run's seed-to-seed scatter: measured from replicates, else the whole hold-out RMSE
+        """One run's seed-to-seed scatter: measured from replicates, else the whole cross-validated RMSE
         (a store without replicates cannot split its error; all of it counts as scatter)."""
         return self.scatter if np.isfinite(self.scatter) else self.rmse
 
     @property
     def net_error(self) -> float:
-        """The net's own error: its hold-out RMSE less the seed scatter it contains, at least a fifth
+        """The net's own error: its cross-validated RMSE less the seed scatter it contains, at least a fifth
         of the RMSE (also when the scatter is unknown)."""
         return float(np.sqrt(max(self.rmse ** 2 - self.seed_sd ** 2, (0.2 * self.rmse) ** 2)))
 
@@ -65,6 +73,25 @@ class QuantityNet:
         value scatters at least as much as one rig run does (a lab's repeat scatter is not smaller
         than the model specimen's), so max(u, seed scatter), plus the net's error."""
         return float(np.sqrt(max(u, self.seed_sd) ** 2 + self.net_error ** 2))
+
+    def total_sd(self, x: np.ndarray) -> np.ndarray:
+        """(m,): sd of one run about the net at inputs x (m, inputs): the error model where there is
+        one (inputs clipped to the campaign box, the sd to [RMSE / ERROR_SPAN, RMSE * ERROR_SPAN]),
+        else the RMSE."""
+        x = np.atleast_2d(x)
+        if self.err_c is None:
+            return np.full(len(x), self.rmse)
+        s = np.clip((x - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0, -1.0, 1.0)
+        return np.clip(np.exp(self.err_c0 + s @ self.err_c), self.rmse / ERROR_SPAN, self.rmse * ERROR_SPAN)
+
+    def errors_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(seed scatter, net error), each (m,), at inputs x: the total sd there split as seed_sd and
+        net_error split the RMSE — the replicates' pooled scatter, at most the total sd (the pooled
+        value comes from a few points; where the net's runs scatter less, so does a repeat), and the
+        rest the net's, at least a fifth of the total."""
+        t = self.total_sd(x)
+        seed = np.minimum(self.scatter, t) if np.isfinite(self.scatter) else t
+        return seed, np.sqrt(np.maximum(t * t - seed * seed, (0.2 * t) ** 2))
 
     def _hidden(self, x: np.ndarray):
         s = (x - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
@@ -98,14 +125,43 @@ class QuantityNet:
                                              "inputs": self.input_names, "y_lo": self.y_lo, "y_hi": self.y_hi,
                                              "b2": self.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
                                              "unit": self.unit, "scatter": self.scatter,
-                                             "test_correlation": self.test_correlation, "format": NET_FORMAT}))}
+                                             "test_correlation": self.test_correlation, "err_c0": self.err_c0,
+                                             "format": NET_FORMAT})),
+                **({"err_c": self.err_c} if self.err_c is not None else {})}
 
     @classmethod
     def from_arrays(cls, a) -> "QuantityNet":
         meta = json.loads(str(a["meta"]))
         return cls(Quantity(meta["rig"], meta["metric"]), meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
                    a["w1"], a["b1"], a["w2"], meta["b2"], meta["rmse"], meta["r2"], meta["runs"], meta["unit"],
-                   meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0))
+                   meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0), meta.get("err_c0", float("nan")),
+                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None)
+
+
+def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prior_sd: float = 0.5):
+    """log sd(x) = c0 + c . s(x) (s: the net's scaled inputs) by maximum a posteriori on the
+    cross-validated residuals r_i ~ N(0, sd(x_i)^2), each c_j with a N(0, prior_sd^2) prior (a
+    one-unit step of a scaled input changes the sd by ~exp(0.5) at most, unless the residuals
+    insist). Why: a net's error is not one number over the box — the ring-shear nets miss by ~5x
+    more at high cohesion and low pre-shear than at a free-flowing point, and one pooled RMSE
+    made every free-flowing material's rows look 2-3x less certain than they are (chi^2/dof 0.2
+    on the shipped synthetic material). The objective is convex."""
+    from scipy import optimize
+    s = np.clip((np.atleast_2d(x) - net.lo) * (2.0 / (net.hi - net.lo)) - 1.0, -1.0, 1.0)
+    r2 = np.asarray(residuals, dtype=float) ** 2
+    ok = np.isfinite(r2) & np.all(np.isfinite(s), axis=1)
+    s, r2 = s[ok], r2[ok]
+    a = np.column_stack([np.ones(len(s)), s])
+    scale = np.r_[0.0, np.full(s.shape[1], 1.0 / prior_sd ** 2)]
+
+    def f(c):
+        eta = a @ c
+        w = r2 * np.exp(-2.0 * eta)
+        return float(np.sum(eta + 0.5 * w) + 0.5 * np.sum(scale * c * c)), a.T @ (1.0 - w) + scale * c
+
+    c0 = np.r_[0.5 * np.log(np.mean(r2) + 1e-300), np.zeros(s.shape[1])]
+    res = optimize.minimize(f, c0, jac=True, method="L-BFGS-B")
+    net.err_c0, net.err_c = float(res.x[0]), res.x[1:].copy()
 
 
 def replicate_store_path(store) -> Path:
@@ -154,6 +210,7 @@ def test_correlation(store, net: QuantityNet) -> float:
 
 def store_hash(store, pooled=()) -> str:
     h = hashlib.sha256()
+    h.update(f"nets {NET_FORMAT} bag {BAG} folds {FOLDS} sizes {SIZES} error span {ERROR_SPAN}".encode())
     rep = replicate_store_path(store)
     if rep.exists():
         h.update(rep.read_bytes())
@@ -172,25 +229,33 @@ def cache_dir(store) -> Path:
 def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
     """Trains one net per quantity of the store and the stores pooled with it (seeded,
     deterministic on one machine)."""
-    from nn.mlp import select_net
+    from nn.mlp import bagged_net, cross_validate
     nets = {}
     for q, (names, x, y) in training_tables(store, pooled).items():
         if len(y) < 20:
             say(f"  {q.key}: {len(y)} finished runs, too few to train a surrogate; skipped")
             continue
         t0 = time.perf_counter()
-        net, _ = select_net(q.key, names, x, y, sizes=SIZES, restarts=RESTARTS, seed=0)
-        lin1, lin2 = net.model.hidden, net.model.out
         unit = ""
         if q.metric in store.metric_names:
             unit = store.metric_units[store.metric_names.index(q.metric)]
+        # one run's rows (its shear points) are one group: they leave the fit together
+        _, groups = np.unique(x[:, :len(store.spec.names)], axis=0, return_inverse=True)
+        scores = {h: cross_validate(x, y, groups, h, BAG, folds=FOLDS, seed=0) for h in SIZES}
+        h = min(SIZES, key=lambda k: (scores[k]["rmse"], k))
+        cv = scores[h]
+        net = bagged_net(q.key, names, x, y, h, BAG, seed=0, unit=unit)
+        lin1, lin2 = net.model.hidden, net.model.out
         nets[q] = QuantityNet(q, list(names), net.x_scaler.lo.copy(), net.x_scaler.hi.copy(), float(net.y_scaler.lo[0]),
                               float(net.y_scaler.hi[0]), lin1.weight.detach().numpy().copy(),
                               lin1.bias.detach().numpy().copy(), lin2.weight.detach().numpy()[0].copy(),
-                              float(lin2.bias.detach().numpy()[0]), float(net.info["holdout_rmse"]),
-                              float(net.info["holdout_r2"]), int(len(y)), unit)
-        say(f"  {q.key:28s} {len(y):4d} rows  hidden {net.hidden:2d}  hold-out R^2 {net.info['holdout_r2']:.3f}  "
-            f"RMSE {net.info['holdout_rmse']:.4g}  ({time.perf_counter() - t0:.0f} s)")
+                              float(lin2.bias.detach().numpy()[0]), cv["rmse"], cv["r2"], int(len(y)), unit)
+        fit_error_model(nets[q], x, y - cv["predicted"])
+        sd = nets[q].total_sd(x)
+        say(f"  {q.key:28s} {len(y):4d} rows  {BAG} x {h:2d} hidden  {FOLDS}-fold CV R^2 {cv['r2']:.3f}  "
+            f"RMSE {cv['rmse']:.4g}  (sizes " + ", ".join(f"{k}: {scores[k]['r2']:.3f}" for k in SIZES) +
+            f"; {time.perf_counter() - t0:.0f} s); error model: sd {np.percentile(sd, 10):.3g}-{np.percentile(sd, 90):.3g} "
+            f"(10-90 % of the runs)")
     return nets
 
 

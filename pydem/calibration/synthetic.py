@@ -94,43 +94,56 @@ def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidat
     return Truth(theta, c.name, c.parameter, strength)
 
 
-def with_lab_noise(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator) -> list[Observation]:
+def with_lab_noise(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator,
+                   truth_inputs: list | None = None) -> list[Observation]:
     """Pseudo-measurements from model values (observation index -> the value before noise: a
     surrogate mean with seed scatter, or one DEM run): lab noise added, each row's uncertainty
-    the noise and one run's seed scatter combined."""
+    the noise and one run's seed scatter combined — the scatter at the truth's inputs
+    (`truth_inputs`, from row_inputs) where given, else the quantity's pooled one."""
     out = []
     for i, o in enumerate(obs):
         v = values[i]
         n = noise_sd(o.quantity.metric, v)
-        s = nets[o.quantity].seed_sd
+        s = _seed_sd(nets[o.quantity], None if truth_inputs is None else truth_inputs[i])
         # every quantity here is positive: a noise draw below zero (a nearly jammed hopper) is clipped
         value = max(float(v + rng.normal(0.0, n)), 1e-3 * abs(float(v)), 1e-9)
         out.append(Observation(o.quantity, dict(o.conditions), value, float(math.hypot(n, s)), o.label))
     return out
 
 
+def _seed_sd(net, x) -> float:
+    """One run's seed scatter: the net's error model at inputs x (1, inputs), or its pooled value."""
+    if x is not None and hasattr(net, "errors_at"):
+        return float(net.errors_at(x)[0][0])
+    return float(net.seed_sd)
+
+
+def row_inputs(nets: dict, candidates: list[Candidate], truth: Truth, obs: list[Observation]) -> list[np.ndarray]:
+    """Each observation's net inputs (1, inputs) at the truth: its parameters and the row's conditions."""
+    inp = truth.inputs(candidates)
+    return [np.array([[o.conditions.get(n, inp.get(n, math.nan)) for n in nets[o.quantity].input_names]]) for o in obs]
+
+
 def surrogate_values(nets: dict, candidates: list[Candidate], truth: Truth, obs: list[Observation]) -> dict[int, float]:
     """The nets' values at the truth for every observation (no scatter, no noise)."""
-    inp = truth.inputs(candidates)
-    values = {}
-    for i, o in enumerate(obs):
-        net = nets[o.quantity]
-        x = np.array([[o.conditions.get(n, inp.get(n, math.nan)) for n in net.input_names]])
-        values[i] = float(net(x)[0])
-    return values
+    return {i: float(nets[o.quantity](x)[0]) for i, (o, x) in enumerate(zip(obs, row_inputs(nets, candidates, truth, obs)))}
 
 
 def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
                   obs: list[Observation]) -> list[Observation]:
     """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
     values = surrogate_values(nets, candidates, truth, obs)
-    return with_lab_noise(obs, {i: values[i] + d for i, d in enumerate(seed_scatter_draw(nets, obs, rng))}, nets, rng)
+    xs = row_inputs(nets, candidates, truth, obs)
+    draw = seed_scatter_draw(nets, obs, rng, xs)
+    return with_lab_noise(obs, {i: values[i] + d for i, d in enumerate(draw)}, nets, rng, xs)
 
 
-def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generator) -> np.ndarray:
+def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generator,
+                      truth_inputs: list | None = None) -> np.ndarray:
     """One draw of the rigs' seed scatter over a programme, as DEM runs make it: one run per test,
     so the points of one test (the shear points of one pre-shear stress) share a part of it
-    (the net's `test_correlation`), and different tests are independent."""
+    (the net's `test_correlation`), and different tests are independent. Its size: the nets'
+    error models at the truth's inputs where given."""
     out = np.zeros(len(obs))
     tests: dict = {}
     for i, o in enumerate(obs):
@@ -141,7 +154,8 @@ def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generat
         rho = getattr(net, "test_correlation", 0.0) if len(rows) > 1 else 0.0
         shared = rng.normal()
         for i in rows:
-            out[i] = net.seed_sd * (math.sqrt(rho) * shared + math.sqrt(1.0 - rho) * rng.normal())
+            sd = _seed_sd(net, None if truth_inputs is None else truth_inputs[i])
+            out[i] = sd * (math.sqrt(rho) * shared + math.sqrt(1.0 - rho) * rng.normal())
     return out
 
 
@@ -210,7 +224,9 @@ def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth,
     failed are left out."""
     values = rig_values(stores, truth.inputs(candidates), obs, seed, threads, say)
     keep = sorted(values)
-    return with_lab_noise([obs[i] for i in keep], {k: values[i] for k, i in enumerate(keep)}, nets, rng)
+    kept = [obs[i] for i in keep]
+    return with_lab_noise(kept, {k: values[i] for k, i in enumerate(keep)}, nets, rng,
+                          row_inputs(nets, candidates, truth, kept))
 
 
 def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):

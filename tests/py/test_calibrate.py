@@ -35,8 +35,8 @@ def pseudo_measurements(tmp_path, tiny, truth):
     rows = []
     for o, v in zip(obs, values):
         test = {"ring-shear": "ring_shear"}.get(o.quantity.rig, o.quantity.rig)
-        cond = ";".join(f"{k}={x:g}" for k, x in o.conditions.items())
-        rows.append(f"m,{test},{o.quantity.metric},{v:.8g},{0.02 * abs(v):.4g},,{cond},calibrate,test")
+        cond = ";".join(f"{k}={x:.17g}" for k, x in o.conditions.items())
+        rows.append(f"m,{test},{o.quantity.metric},{v:.17g},{0.02 * abs(v):.4g},,{cond},calibrate,test")
     f = tmp_path / "m.csv"
     f.write_text(HEADER + "\n".join(rows) + "\n")
     return f, obs, model
@@ -122,7 +122,8 @@ def test_a_row_at_another_condition_than_a_fixed_store_is_left_out(tmp_path):
     left out, never matched to the campaign's condition; `unknown` takes the campaign's."""
     import shutil
     from pydem.calibration.setup import load_setup, observations_from_file
-    shutil.copy(ROOT / "data/campaigns/ring_shear_cell.h5", tmp_path)  # its nets are trained and cached beside it
+    shutil.copy(ROOT / "data/campaigns/ring_shear_cell.h5", tmp_path)
+    shutil.copytree(ROOT / "data/campaigns/ring_shear_cell.h5.nets", tmp_path / "ring_shear_cell.h5.nets")  # cached nets
     setup = load_setup([tmp_path / "ring_shear_cell.h5"], say=lambda *_: None)
     f = tmp_path / "m.csv"
     f.write_text(HEADER + "x,ring_shear,mu_ie_ps,0.5,0.01,,preshear_stress=5000,calibrate,s\n"

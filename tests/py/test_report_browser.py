@@ -31,11 +31,10 @@ def pixels_near(img: np.ndarray, rgb, tol: float = 0.06) -> int:
 @pytest.mark.parametrize("command", ["calibrate", "diagnose"])
 def test_report_renders_with_its_images(command, tmp_path):
     from matplotlib.image import imread
-    from pydem.calibration.setup import TINY_STORES
     out = tmp_path / command
     extra = ["--samples", "16384"] if command == "calibrate" else []
     r = subprocess.run([sys.executable, "-m", "pydem", command, str(MEAS), "--material", "synthetic_cohesive",
-                        "--out", str(out), "--stores", *TINY_STORES, *extra], cwd=ROOT, capture_output=True, text=True,
+                        "--out", str(out), *extra], cwd=ROOT, capture_output=True, text=True,
                        timeout=600)
     assert r.returncode == 0, r.stderr
     log = screenshot(out / "report.html", tmp_path / "shot.png")
