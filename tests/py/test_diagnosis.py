@@ -267,3 +267,26 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     dem = synthetic.validate(setup, {"null": 1}, seed=13, source="dem", say=lambda *a: None)
     assert dem[0]["verdict"] in ("no_effect_needed", "effect", "indistinguishable", "unexplained")
     assert dem[0]["chi2_before"] > 0
+
+
+def test_the_error_model_finds_where_the_error_is_and_splits_it():
+    """fit_error_model on residuals whose sd grows as exp(0.8 s_0) over the first scaled input
+    (and not with the second) recovers that slope within 0.15 (its standard error with 3,000
+    residuals is ~0.02; the N(0, 0.5^2) prior shrinks it by < 1 %), the second slope near 0; and
+    errors_at splits the sd into the pooled seed scatter (capped by the total) and the rest."""
+    from pydem.calibration.quantities import Quantity
+    from pydem.calibration.surrogates import QuantityNet, fit_error_model
+    rng = np.random.default_rng(8)
+    net = QuantityNet(Quantity("aor", "angle_of_repose"), ["a", "b"], np.zeros(2), np.ones(2), 0.0, 1.0,
+                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.15, r2=0.5, runs=3000)
+    x = rng.uniform(0, 1, (3000, 2))
+    s0 = 2 * x[:, 0] - 1
+    r = 0.1 * np.exp(0.8 * s0) * rng.normal(size=3000)
+    fit_error_model(net, x, r)
+    assert abs(net.err_c[0] - 0.8) < 0.15 and abs(net.err_c[1]) < 0.15, net.err_c
+    lo_sd, hi_sd = net.total_sd(np.array([[0.0, 0.5], [1.0, 0.5]]))
+    assert 0.035 < lo_sd < 0.06 and 0.18 < hi_sd < 0.27, (lo_sd, hi_sd)
+    net.scatter = 0.08
+    seed, err = net.errors_at(np.array([[0.0, 0.5], [1.0, 0.5]]))
+    assert seed[0] == pytest.approx(lo_sd) and seed[1] == pytest.approx(0.08)
+    assert err[0] == pytest.approx(0.2 * lo_sd) and err[1] == pytest.approx(np.sqrt(hi_sd ** 2 - 0.08 ** 2))

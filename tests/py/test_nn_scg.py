@@ -144,3 +144,42 @@ def test_selection_reaches_the_noise_floor_on_campaign_sized_noisy_data():
         gaps.append(r2_score(y[hold], truth(x[hold])) - net.info["best_holdout_r2"])
     # tolerance: a 16-point hold-out R^2 scatters by ~0.02 between equally good nets
     assert np.mean(gaps) < 0.025, gaps
+
+
+def test_a_bag_is_one_net_equal_to_the_mean_of_its_members():
+    """bagged_net merges its members into one wider net: its output is the members' mean, which
+    is checked here by building the members again with the same seeds; and that one net exports
+    to libdem's text format and evaluates there to round-off (the screening path)."""
+    from nn.export import weights_text
+    from nn.mlp import PropertyNet, bagged_net
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1, 1, (120, 3))
+    y = np.sin(2 * x[:, 0]) + x[:, 1] ** 2 + 0.02 * rng.normal(size=120)
+    bag = bagged_net("b", ["a", "b", "c"], x, y, hidden=4, members=3, seed=0)
+    assert bag.hidden == 12 and bag.info["members"] == 3
+    xs, ys = bag.x_scaler.forward(x), bag.y_scaler.forward(y[:, None])[:, 0]
+    means = []
+    for k in range(3):
+        m, _ = train_net(xs, ys, 4, seed=104729 + 131 * 4 + k)
+        means.append(PropertyNet("m", ["a", "b", "c"], bag.x_scaler, bag.y_scaler, m).predict(x))
+    np.testing.assert_allclose(bag.predict(x), np.mean(means, axis=0), rtol=0, atol=1e-12)
+    from pydem.mlp import NativeMLP
+    native = NativeMLP(text=weights_text(bag))
+    np.testing.assert_allclose(native(x), bag.predict(x), rtol=1e-12, atol=1e-12)
+
+
+def test_cross_validation_keeps_a_group_in_one_fold_and_scores_out_of_fold():
+    """Rows of one group (one run's shear points) leave the fit together: a group whose rows are
+    exact copies would be predicted perfectly if its twin stayed in the fit. Here every group is
+    three copies of one noisy point, so an in-fold copy would make the out-of-fold RMSE ~0; kept
+    together, the RMSE is the noise's (0.1) within the sampling error of 80 groups, not below
+    half of it."""
+    from nn.mlp import cross_validate
+    rng = np.random.default_rng(5)
+    x1 = rng.uniform(-1, 1, (80, 2))
+    y1 = x1[:, 0] + 0.5 * x1[:, 1] + 0.1 * rng.normal(size=80)
+    x, y, groups = np.repeat(x1, 3, axis=0), np.repeat(y1, 3), np.repeat(np.arange(80), 3)
+    cv = cross_validate(x, y, groups, hidden=3, members=2, folds=5)
+    assert np.all(np.isfinite(cv["predicted"]))
+    assert 0.06 < cv["rmse"] < 0.2, cv["rmse"]
+    assert cv["r2"] > 0.9
