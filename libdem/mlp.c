@@ -70,20 +70,21 @@ static int copy_word(char *dst, const char *src, size_t len, int line, const cha
 }
 
 enum { F_MAGIC = 1, F_NAME = 2, F_UNIT = 4, F_INPUTS = 8, F_HIDDEN = 16, F_INLO = 32, F_INHI = 64, F_OUTLO = 128,
-       F_OUTHI = 256, F_W1 = 512, F_B1 = 1024, F_W2 = 2048, F_B2 = 4096, F_ALL = 8191 };
+       F_OUTHI = 256, F_W1 = 512, F_B1 = 1024, F_W2 = 2048, F_B2 = 4096, F_ALL = 8191 /* required */,
+       F_TRANSFORM = 8192 /* optional */ };
 
 static const char *field_names[] = {"dem-mlp", "name", "unit", "inputs", "hidden", "input_lo", "input_hi",
-                                    "output_lo", "output_hi", "w1", "b1", "w2", "b2"};
+                                    "output_lo", "output_hi", "w1", "b1", "w2", "b2", "output_transform"};
 
 /* One keyword line; returns the field bit it set, 0 on error (message written). */
 static int parse_line(dem_mlp *m, const char *key, size_t klen, const char *rest, int seen, int line, char *err,
                       size_t err_size)
 {
     int f;
-    for (f = 0; f < 13; ++f)
+    for (f = 0; f < 14; ++f)
         if (strlen(field_names[f]) == klen && strncmp(key, field_names[f], klen) == 0)
             break;
-    if (f == 13) {
+    if (f == 14) {
         dem_mlp_set_error(err, err_size, "line %d: unknown keyword '%.*s'", line, (int)klen, key);
         return 0;
     }
@@ -163,7 +164,20 @@ static int parse_line(dem_mlp *m, const char *key, size_t klen, const char *rest
     case 9: if (!read_numbers(rest, m->w1, m->nhid * m->nin, line, "w1", err, err_size)) return 0; break;
     case 10: if (!read_numbers(rest, m->b1, m->nhid, line, "b1", err, err_size)) return 0; break;
     case 11: if (!read_numbers(rest, m->w2, m->nhid, line, "w2", err, err_size)) return 0; break;
-    default: if (!read_numbers(rest, &m->b2, 1, line, "b2", err, err_size)) return 0; break;
+    case 12: if (!read_numbers(rest, &m->b2, 1, line, "b2", err, err_size)) return 0; break;
+    default: {
+        size_t len = strcspn(rest, " \t\r");
+        if (len == 8 && strncmp(rest, "identity", 8) == 0)
+            m->out_log = 0;
+        else if (len == 3 && strncmp(rest, "log", 3) == 0)
+            m->out_log = 1;
+        else {
+            dem_mlp_set_error(err, err_size, "line %d (output_transform): 'identity' or 'log', not '%.*s'", line,
+                              (int)len, rest);
+            return 0;
+        }
+        break;
+    }
     }
     return 1 << f;
 }
@@ -218,7 +232,7 @@ dem_status dem_mlp_parse(const char *text, dem_mlp **out, char *err, size_t err_
         }
         seen |= bit;
     }
-    if (seen != F_ALL) {
+    if ((seen & F_ALL) != F_ALL) {
         int f;
         for (f = 0; f < 13 && (seen & (1 << f)); ++f) {
         }
@@ -324,6 +338,8 @@ dem_status dem_mlp_save(const dem_mlp *m, const char *path, char *err, size_t er
     write_values(fp, "b1", m->b1, m->nhid);
     write_values(fp, "w2", m->w2, m->nhid);
     write_values(fp, "b2", &m->b2, 1);
+    if (m->out_log)
+        fprintf(fp, "output_transform log\n");
     if (fclose(fp) != 0) {
         dem_mlp_set_error(err, err_size, "%s: write error", path);
         return DEM_ERR_IO;
@@ -352,5 +368,6 @@ double dem_mlp_eval(const dem_mlp *m, const double *x)
             z += m->w1[j * m->nin + i] * xs[i];
         y += m->w2[j] * tanh(z);
     }
-    return (y + 1.0) * ((m->out_hi - m->out_lo) / 2.0) + m->out_lo;
+    y = (y + 1.0) * ((m->out_hi - m->out_lo) / 2.0) + m->out_lo;
+    return m->out_log ? exp(y) : y;
 }

@@ -15,6 +15,7 @@ struct dem_mlp {
     int nin, nhid;
     double in_lo[DEM_MLP_MAX_INPUTS], in_hi[DEM_MLP_MAX_INPUTS];
     double out_lo, out_hi, b2;
+    int out_log; /* output_transform log: y = exp(scaled output) (a positive quantity learnt as its log) */
     double *w1; /* nhid x nin */
     double *b1; /* nhid */
     double *w2; /* nhid */

@@ -87,6 +87,9 @@ static void eval_block(const dem_mlp *m, const double *x, int nb, double *xs, do
     }
     for (b = 0; b < nb; ++b)
         y[b] = (acc[b] + 1.0) * half + m->out_lo;
+    if (m->out_log)
+        for (b = 0; b < nb; ++b)
+            y[b] = exp(y[b]);
 }
 
 dem_status dem_mlp_eval_many(const dem_mlp *m, const double *x, size_t n, double *y, int num_threads)

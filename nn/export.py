@@ -43,6 +43,7 @@ class NetArrays:
     b1: np.ndarray
     w2: np.ndarray   # hidden
     b2: float
+    log_output: bool = False  # y = exp(scaled output): a positive quantity learnt as its log
 
     @property
     def hidden(self) -> int:
@@ -61,7 +62,7 @@ def arrays_of(net) -> NetArrays:
     return NetArrays(net.name, net.unit, list(net.input_names), net.x_scaler.lo, net.x_scaler.hi,
                      float(net.y_scaler.lo[0]), float(net.y_scaler.hi[0]), m.hidden.weight.detach().numpy().copy(),
                      m.hidden.bias.detach().numpy().copy(), m.out.weight.detach().numpy()[0].copy(),
-                     float(m.out.bias.detach().numpy()[0]))
+                     float(m.out.bias.detach().numpy()[0]), bool(getattr(net, "log_output", False)))
 
 
 def weights_text(net) -> str:
@@ -71,6 +72,8 @@ def weights_text(net) -> str:
              f"inputs {len(a.input_names)} {' '.join(a.input_names)}", f"hidden {a.hidden}",
              f"input_lo {_hex(a.lo)}", f"input_hi {_hex(a.hi)}", f"output_lo {_hex(a.y_lo)}", f"output_hi {_hex(a.y_hi)}",
              f"w1 {_hex(a.w1)}", f"b1 {_hex(a.b1)}", f"w2 {_hex(a.w2)}", f"b2 {_hex(a.b2)}"]
+    if a.log_output:
+        lines.append("output_transform log")
     return "\n".join(lines) + "\n"
 
 
@@ -103,7 +106,8 @@ def read_weights(path: str | Path):
         model.out.bias.copy_(torch.from_numpy(f["b2"]))
     unit = fields["unit"][0] if fields.get("unit") and fields["unit"][0] != "-" else ""
     return PropertyNet(fields["name"][0], names, Scaler(f["input_lo"], f["input_hi"]),
-                       Scaler(f["output_lo"], f["output_hi"]), model, unit)
+                       Scaler(f["output_lo"], f["output_hi"]), model, unit,
+                       log_output=fields.get("output_transform") == ["log"])
 
 
 def c_identifier(name: str) -> str:
@@ -162,7 +166,8 @@ double {ident}(const double x[{nin}])
             z += w1[j * {nin} + i] * xs[i];
         y += w2[j] * tanh(z);
     }}
-    return (y + 1.0) * ((output_hi - output_lo) / 2.0) + output_lo;
+    y = (y + 1.0) * ((output_hi - output_lo) / 2.0) + output_lo;
+    return {"exp(y)" if net.log_output else "y"};
 }}
 """
     h, c = directory / f"{ident}.h", directory / f"{ident}.c"

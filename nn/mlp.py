@@ -61,6 +61,7 @@ class PropertyNet:
     model: MLP
     unit: str = ""
     info: dict = field(default_factory=dict)
+    log_output: bool = False  # the net learnt log(y): predict() returns exp of its scaled output
 
     @property
     def hidden(self) -> int:
@@ -70,7 +71,8 @@ class PropertyNet:
         xs = torch.from_numpy(self.x_scaler.forward(np.atleast_2d(x)))
         with torch.no_grad():
             ys = self.model(xs).numpy()
-        return self.y_scaler.inverse(ys[:, None])[:, 0]
+        y = self.y_scaler.inverse(ys[:, None])[:, 0]
+        return np.exp(y) if self.log_output else y
 
 
 def r2_score(y: np.ndarray, pred: np.ndarray) -> float:
@@ -185,15 +187,19 @@ def select_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
 
 
 def bagged_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, hidden: int, members: int = 4,
-               seed: int = 0, unit: str = "") -> PropertyNet:
+               seed: int = 0, unit: str = "", log_target: bool = False) -> PropertyNet:
     """The mean of `members` nets of `hidden` units trained on all of (x, y) (restarts with their
     own seeds and validation splits). The mean of tanh nets with one hidden layer is again one:
     the members' hidden units side by side, their output weights divided by `members` — so a bag
     exports, screens and differentiates like any net. Why: on ~100-400 campaign runs one
     restart is a draw; in 5-fold cross-validation on the ring-shear runs one selected net reached
     R^2 -0.34 for mu_ie_s (one fold's net extrapolated wildly) where the mean of 4 reached 0.59
-    (docs/surrogates.md)."""
+    (docs/surrogates.md). log_target: the members learn log(y) (y > 0), the net returns exp."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if log_target:
+        if np.any(y <= 0):
+            raise ValueError(f"{name}: a log target needs positive values")
+        y = np.log(y)
     xsc, ysc = Scaler.fit(x), Scaler.fit(y[:, None])
     xs, ys = xsc.forward(x), ysc.forward(y[:, None])[:, 0]
     models = [train_net(xs, ys, hidden, seed=seed * 7919 + 104729 + 131 * hidden + k)[0] for k in range(members)]
@@ -203,14 +209,15 @@ def bagged_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
         bag.hidden.bias.copy_(torch.cat([m.hidden.bias for m in models]))
         bag.out.weight.copy_(torch.cat([m.out.weight for m in models], dim=1) / members)
         bag.out.bias.copy_(torch.stack([m.out.bias for m in models]).mean(dim=0))
-    net = PropertyNet(name, list(input_names), xsc, ysc, bag, unit)
+    net = PropertyNet(name, list(input_names), xsc, ysc, bag, unit, log_output=log_target)
+    y_phys = np.exp(y) if log_target else y
     net.info = {"members": members, "member_hidden": hidden, "samples": int(len(y)),
-                "train_r2": r2_score(y, net.predict(x))}
+                "train_r2": r2_score(y_phys, net.predict(x))}
     return net
 
 
 def cross_validate(x: np.ndarray, y: np.ndarray, groups: np.ndarray, hidden: int, members: int = 4, folds: int = 5,
-                   seed: int = 0) -> dict:
+                   seed: int = 0, log_target: bool = False) -> dict:
     """K-fold cross-validation of bagged_net: rows of one group (the shear points of one run) stay
     in one fold. Returns the out-of-fold predictions with their RMSE and R^2: the error of a bag
     trained on all the rows, estimated from every row rather than from one 15 % hold-out (on
@@ -224,7 +231,8 @@ def cross_validate(x: np.ndarray, y: np.ndarray, groups: np.ndarray, hidden: int
     for k in range(folds):
         test = fold == k
         if test.any() and (~test).sum() >= 10:
-            net = bagged_net("cv", [], x[~test], y[~test], hidden, members, seed=seed + 17 * (k + 1))
+            net = bagged_net("cv", [], x[~test], y[~test], hidden, members, seed=seed + 17 * (k + 1),
+                             log_target=log_target)
             pred[test] = net.predict(x[test])
     ok = np.isfinite(pred)
     rmse = float(np.sqrt(np.mean((pred[ok] - y[ok]) ** 2)))

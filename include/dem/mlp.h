@@ -3,7 +3,9 @@
  * file, "dem-mlp 1"), and native screening of many parameter combinations with OpenMP.
  *
  * Net: xs = (x - lo) * (2 / (hi - lo)) - 1 per input; z = W1 xs + b1; ys = w2 . tanh(z) + b2;
- * y = (ys + 1) * ((out_hi - out_lo) / 2) + out_lo. Inputs and output in physical units.
+ * y = (ys + 1) * ((out_hi - out_lo) / 2) + out_lo, then exp(y) when the file says
+ * "output_transform log" (a positive quantity learnt as its logarithm; optional, default
+ * identity). Inputs and output in physical units.
  * Errors are written to a caller buffer (err, err_size; either may be NULL/0). */
 #ifndef DEM_MLP_H
 #define DEM_MLP_H

@@ -2,7 +2,8 @@
 
 Trained once per campaign store (nn.mlp.bagged_net: the mean of BAG tanh MLPs trained with SCG
 on all runs, itself one wider net; the members' hidden size the one of SIZES with the lowest
-FOLDS-fold cross-validated RMSE) and cached next to the store as plain arrays (`<store>.nets/`, keyed by
+FOLDS-fold cross-validated RMSE; a positive quantity learnt as its log where that RMSE is lower)
+and cached next to the store as plain arrays (`<store>.nets/`, keyed by
 a hash of the store's runs), so a diagnosis loads them in milliseconds and gets the same
 numbers on every machine. Evaluation and Jacobians are numpy (one hidden layer: the Jacobian
 is analytic).
@@ -26,7 +27,7 @@ import numpy as np
 
 from .quantities import Quantity, fraction_columns, training_tables
 
-NET_FORMAT = 2  # 2: bagged nets with an error model (a cache of format 1 is retrained)
+NET_FORMAT = 3  # 3: bagged nets with an error model, log target where it fits better (older caches are retrained)
 SIZES = (3, 6, 10, 16)  # hidden units per bagged member, chosen by the cross-validated RMSE
 BAG = 4     # nets averaged per quantity (nn.mlp.bagged_net)
 FOLDS = 5   # cross-validation folds for the error model
@@ -55,6 +56,7 @@ class QuantityNet:
     # to the cross-validated residuals (fit_error_model); None: the RMSE everywhere
     err_c0: float = float("nan")
     err_c: np.ndarray | None = None
+    log_output: bool = False  # the net learnt log(value) (a positive quantity): f = exp(scaled output)
 
     @property
     def seed_sd(self) -> float:
@@ -100,13 +102,15 @@ class QuantityNet:
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """x: (m, inputs) -> (m,)"""
         h = self._hidden(np.atleast_2d(x))
-        return (h @ self.w2 + self.b2 + 1.0) * (0.5 * (self.y_hi - self.y_lo)) + self.y_lo
+        y = (h @ self.w2 + self.b2 + 1.0) * (0.5 * (self.y_hi - self.y_lo)) + self.y_lo
+        return np.exp(y) if self.log_output else y
 
     def gradient(self, x: np.ndarray) -> np.ndarray:
         """x: (m, inputs) -> (m, inputs): d f / d x."""
         h = self._hidden(np.atleast_2d(x))
         g = ((1.0 - h * h) * self.w2) @ self.w1  # d y_s / d s
-        return g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
+        g = g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
+        return g * self(x)[:, None] if self.log_output else g
 
     @property
     def name(self) -> str:
@@ -117,7 +121,7 @@ class QuantityNet:
         """The net as nn.export.NetArrays (weights file for libdem, standalone C)."""
         from nn.export import NetArrays
         return NetArrays(self.name, self.unit, list(self.input_names), self.lo, self.hi, self.y_lo, self.y_hi,
-                         self.w1, self.b1, self.w2, self.b2)
+                         self.w1, self.b1, self.w2, self.b2, self.log_output)
 
     def to_arrays(self) -> dict:
         return {"lo": self.lo, "hi": self.hi, "w1": self.w1, "b1": self.b1, "w2": self.w2,
@@ -126,6 +130,7 @@ class QuantityNet:
                                              "b2": self.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
                                              "unit": self.unit, "scatter": self.scatter,
                                              "test_correlation": self.test_correlation, "err_c0": self.err_c0,
+                                             "log_output": self.log_output,
                                              "format": NET_FORMAT})),
                 **({"err_c": self.err_c} if self.err_c is not None else {})}
 
@@ -135,7 +140,7 @@ class QuantityNet:
         return cls(Quantity(meta["rig"], meta["metric"]), meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
                    a["w1"], a["b1"], a["w2"], meta["b2"], meta["rmse"], meta["r2"], meta["runs"], meta["unit"],
                    meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0), meta.get("err_c0", float("nan")),
-                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None)
+                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None, meta.get("log_output", False))
 
 
 def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prior_sd: float = 0.5):
@@ -243,16 +248,21 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
         _, groups = np.unique(x[:, :len(store.spec.names)], axis=0, return_inverse=True)
         scores = {h: cross_validate(x, y, groups, h, BAG, folds=FOLDS, seed=0) for h in SIZES}
         h = min(SIZES, key=lambda k: (scores[k]["rmse"], k))
-        cv = scores[h]
-        net = bagged_net(q.key, names, x, y, h, BAG, seed=0, unit=unit)
+        cv, log_target = scores[h], False
+        if np.all(y > 0):  # a positive quantity may be learnt as its log: kept where the CV RMSE says so
+            cv_log = cross_validate(x, y, groups, h, BAG, folds=FOLDS, seed=0, log_target=True)
+            if cv_log["rmse"] < cv["rmse"]:
+                cv, log_target = cv_log, True
+        net = bagged_net(q.key, names, x, y, h, BAG, seed=0, unit=unit, log_target=log_target)
         lin1, lin2 = net.model.hidden, net.model.out
         nets[q] = QuantityNet(q, list(names), net.x_scaler.lo.copy(), net.x_scaler.hi.copy(), float(net.y_scaler.lo[0]),
                               float(net.y_scaler.hi[0]), lin1.weight.detach().numpy().copy(),
                               lin1.bias.detach().numpy().copy(), lin2.weight.detach().numpy()[0].copy(),
-                              float(lin2.bias.detach().numpy()[0]), cv["rmse"], cv["r2"], int(len(y)), unit)
+                              float(lin2.bias.detach().numpy()[0]), cv["rmse"], cv["r2"], int(len(y)), unit,
+                              log_output=log_target)
         fit_error_model(nets[q], x, y - cv["predicted"])
         sd = nets[q].total_sd(x)
-        say(f"  {q.key:28s} {len(y):4d} rows  {BAG} x {h:2d} hidden  {FOLDS}-fold CV R^2 {cv['r2']:.3f}  "
+        say(f"  {q.key:28s} {len(y):4d} rows  {BAG} x {h:2d} hidden{' log' if log_target else ''}  {FOLDS}-fold CV R^2 {cv['r2']:.3f}  "
             f"RMSE {cv['rmse']:.4g}  (sizes " + ", ".join(f"{k}: {scores[k]['r2']:.3f}" for k in SIZES) +
             f"; {time.perf_counter() - t0:.0f} s); error model: sd {np.percentile(sd, 10):.3g}-{np.percentile(sd, 90):.3g} "
             f"(10-90 % of the runs)")

@@ -5,6 +5,7 @@
 #include "test_util.h"
 
 #include <dem/mlp.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -122,6 +123,7 @@ static void test_malformed_files_are_named(void **state)
         {"input_hi", "input_hi 1 0.6 0.2", "restitution"},
         {"b2", "b2 1 2", "more than"},
         {"unit", "colour blue", "line 3: unknown keyword 'colour'"},
+        {"b2", "output_transform sqrt", "(output_transform): 'identity' or 'log', not 'sqrt'"},
     };
     char *g = golden_text();
     dem_mlp *net = NULL;
@@ -136,6 +138,42 @@ static void test_malformed_files_are_named(void **state)
     assert_int_equal(dem_mlp_load("tests/data/mlp/no_such_file.mlp", &net, err, sizeof err), DEM_ERR_IO);
     assert_non_null(strstr(err, "no_such_file.mlp"));
     assert_int_equal(dem_mlp_parse(NULL, &net, err, sizeof err), DEM_ERR_NULL);
+    free(g);
+}
+
+/* "output_transform log": the net's output is exp of what the golden net gives (exact: the
+ * same sums, then one exp), in eval, eval_many and after a save round trip; "identity" is the
+ * golden net itself. */
+static void test_log_output_transform(void **state)
+{
+    double x[NROWS][3], y[NROWS], many[NROWS];
+    char *g = golden_text(), err[256] = "";
+    char *text = calloc(1, strlen(g) + 64), *ident = calloc(1, strlen(g) + 64);
+    dem_mlp *net = NULL, *back = NULL, *same = NULL;
+    int i;
+    (void)state;
+    read_golden(x, y);
+    strcpy(text, g);
+    strcat(text, "output_transform log\n");
+    strcpy(ident, g);
+    strcat(ident, "output_transform identity\n");
+    assert_int_equal(dem_mlp_parse(text, &net, err, sizeof err), DEM_OK);
+    assert_int_equal(dem_mlp_parse(ident, &same, err, sizeof err), DEM_OK);
+    assert_int_equal(dem_mlp_eval_many(net, &x[0][0], NROWS, many, 2), DEM_OK);
+    assert_int_equal(dem_mlp_save(net, "build/test_mlp_log.mlp", err, sizeof err), DEM_OK);
+    assert_int_equal(dem_mlp_load("build/test_mlp_log.mlp", &back, err, sizeof err), DEM_OK);
+    for (i = 0; i < NROWS; ++i) {
+        const double want = exp(dem_mlp_eval(same, x[i]));
+        assert_close(dem_mlp_eval(same, x[i]), y[i], 1e-12, 0.0);
+        assert_true(dem_mlp_eval(net, x[i]) == want);
+        assert_true(dem_mlp_eval(back, x[i]) == want);
+        assert_close(many[i], want, 1e-12, 0.0); /* the screening's tanh differs by an ulp or two */
+    }
+    dem_mlp_free(net);
+    dem_mlp_free(back);
+    dem_mlp_free(same);
+    free(text);
+    free(ident);
     free(g);
 }
 
@@ -175,6 +213,7 @@ int main(void)
         cmocka_unit_test(test_golden_outputs),
         cmocka_unit_test(test_save_round_trip_is_exact),
         cmocka_unit_test(test_malformed_files_are_named),
+        cmocka_unit_test(test_log_output_transform),
         cmocka_unit_test(test_screen_keeps_rows_within_the_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -290,3 +290,23 @@ def test_the_error_model_finds_where_the_error_is_and_splits_it():
     seed, err = net.errors_at(np.array([[0.0, 0.5], [1.0, 0.5]]))
     assert seed[0] == pytest.approx(lo_sd) and seed[1] == pytest.approx(0.08)
     assert err[0] == pytest.approx(0.2 * lo_sd) and err[1] == pytest.approx(np.sqrt(hi_sd ** 2 - 0.08 ** 2))
+
+
+def test_a_log_output_quantity_net_has_the_gradient_of_exp():
+    """QuantityNet with log_output: f = exp(net) and its analytic gradient matches central
+    differences (relative 1e-6: step 1e-6 of the input range, truncation ~1e-12)."""
+    from pydem.calibration.quantities import Quantity
+    from pydem.calibration.surrogates import QuantityNet
+    rng = np.random.default_rng(2)
+    net = QuantityNet(Quantity("hopper", "discharge_time"), ["a", "b"], np.zeros(2), np.array([1.0, 2.0]),
+                      -1.0, 1.0, rng.normal(size=(4, 2)), rng.normal(size=4), rng.normal(size=4), 0.1,
+                      rmse=0.1, r2=0.9, runs=100, log_output=True)
+    x = rng.uniform(0.1, 0.9, (5, 2)) * np.array([1.0, 2.0])
+    lin = QuantityNet(**{**net.__dict__, "log_output": False})
+    np.testing.assert_allclose(net(x), np.exp(lin(x)), rtol=1e-14)
+    h = 1e-6
+    for j in range(2):
+        e = np.zeros(2)
+        e[j] = h * (net.hi[j] - net.lo[j])
+        fd = (net(x + e) - net(x - e)) / (2 * e[j])
+        np.testing.assert_allclose(net.gradient(x)[:, j], fd, rtol=1e-6)

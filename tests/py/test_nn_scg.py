@@ -183,3 +183,24 @@ def test_cross_validation_keeps_a_group_in_one_fold_and_scores_out_of_fold():
     assert np.all(np.isfinite(cv["predicted"]))
     assert 0.06 < cv["rmse"] < 0.2, cv["rmse"]
     assert cv["r2"] > 0.9
+
+
+def test_a_log_target_bag_exports_its_transform():
+    """A positive quantity learnt as its log: the bag returns exp of its output, the weights file
+    says `output_transform log`, and libdem evaluates the same values (to the screening's
+    round-off); read_weights gives the same net back."""
+    import tempfile
+    from nn.export import read_weights, weights_text, write_weights
+    from nn.mlp import bagged_net
+    from pydem.mlp import NativeMLP
+    rng = np.random.default_rng(4)
+    x = rng.uniform(0, 1, (100, 2))
+    y = np.exp(1.5 * x[:, 0] - x[:, 1]) * (1 + 0.01 * rng.normal(size=100))
+    bag = bagged_net("t", ["a", "b"], x, y, hidden=3, members=2, log_target=True)
+    assert bag.log_output and "output_transform log" in weights_text(bag)
+    assert np.all(bag.predict(x) > 0) and r2_score(y, bag.predict(x)) > 0.95
+    np.testing.assert_allclose(NativeMLP(text=weights_text(bag))(x), bag.predict(x), rtol=1e-12)
+    with tempfile.TemporaryDirectory() as d:
+        back = read_weights(write_weights(bag, f"{d}/t.mlp"))
+    assert back.log_output
+    np.testing.assert_array_equal(back.predict(x), bag.predict(x))
