@@ -216,8 +216,8 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         if c.side == "+" and step < 0:  # one-sided: a step to unphysical values scores nothing
             s = 0.0
         mjs[c.name] = mje
-        # the base fit's noise model (at = the base optimum, the candidate neutral): LR compares
-        # two chi^2 of one quadratic form
+        # the noise model at the base optimum (the candidate neutral), so that LR compares two
+        # chi^2 of nearly one quadratic form (base.chi2 has it at the first-pass optimum)
         at = np.append(base.best, c.neutral_value(base.as_dict()))
         m = Model(observations, nets, ranges, covered, c, at=at)
         f = minimise(m, start=at)
