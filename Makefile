@@ -130,7 +130,7 @@ bench: setup lib $(BENCH_BIN)
 # admissible set screened natively over 2^20 combinations, nets exported; build/calibration),
 # then the diagnosis loop: a synthetic material made by our rigs with a hidden effect (the loop
 # must find it), and the glass microbeads (build/diagnosis)
-# the synthetic material was made by the tiny rigs: it is diagnosed with the tiny stores
+# the synthetic material was made by the default-preset rigs: it is diagnosed with the default stores
 demo: setup lib
 	@$(MAKE) --no-print-directory pydem
 	.venv/bin/pydem calibrate data/measurements/glass_microbeads.csv --material glass_microbeads --out $(BUILD)/calibration

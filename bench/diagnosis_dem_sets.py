@@ -87,14 +87,10 @@ def diagnose(args):
     for k, line in enumerate(Path(args.journal).read_text().splitlines()):
         row = json.loads(line)
         rng = np.random.default_rng(5000 + k)
-        kept = [r for r in row["rows"] if r["value"] is not None and Quantity(r["rig"], r["metric"]) in setup.nets
-                and r["rig"] not in args.skip_rigs]  # rows of the given stores' rigs only
-        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
-        vals = {i: r["value"] for i, r in enumerate(kept)}
-        t = row["truth"]
-        truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
-        noisy = synthetic.with_lab_noise(obs, vals, setup.nets, rng,
-                                         synthetic.row_inputs(setup.nets, setup.candidates, truth, obs))
+        # rows of the given stores' rigs only
+        _, noisy = synthetic.journal_set(row, setup.nets, setup.candidates, rng,
+                                         keep=lambda r: Quantity(r["rig"], r["metric"]) in setup.nets
+                                         and r["rig"] not in args.skip_rigs)
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,

@@ -185,7 +185,6 @@ def select_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
     return net, table
 
 
-
 def bagged_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, hidden: int, members: int = 4,
                seed: int = 0, unit: str = "", log_target: bool = False) -> PropertyNet:
     """The mean of `members` nets of `hidden` units trained on all of (x, y) (restarts with their
@@ -196,12 +195,11 @@ def bagged_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
     R^2 -0.34 for mu_ie_s (one fold's net extrapolated wildly) where the mean of 4 reached 0.59
     (docs/surrogates.md). log_target: the members learn log(y) (y > 0), the net returns exp."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    if log_target:
-        if np.any(y <= 0):
-            raise ValueError(f"{name}: a log target needs positive values")
-        y = np.log(y)
-    xsc, ysc = Scaler.fit(x), Scaler.fit(y[:, None])
-    xs, ys = xsc.forward(x), ysc.forward(y[:, None])[:, 0]
+    if log_target and np.any(y <= 0):
+        raise ValueError(f"{name}: a log target needs positive values")
+    target = np.log(y) if log_target else y
+    xsc, ysc = Scaler.fit(x), Scaler.fit(target[:, None])
+    xs, ys = xsc.forward(x), ysc.forward(target[:, None])[:, 0]
     models = [train_net(xs, ys, hidden, seed=seed * 7919 + 104729 + 131 * hidden + k)[0] for k in range(members)]
     bag = MLP(x.shape[1], hidden * members)
     with torch.no_grad():
@@ -210,9 +208,8 @@ def bagged_net(name: str, input_names: list[str], x: np.ndarray, y: np.ndarray, 
         bag.out.weight.copy_(torch.cat([m.out.weight for m in models], dim=1) / members)
         bag.out.bias.copy_(torch.stack([m.out.bias for m in models]).mean(dim=0))
     net = PropertyNet(name, list(input_names), xsc, ysc, bag, unit, log_output=log_target)
-    y_phys = np.exp(y) if log_target else y
     net.info = {"members": members, "member_hidden": hidden, "samples": int(len(y)),
-                "train_r2": r2_score(y_phys, net.predict(x))}
+                "train_r2": r2_score(y, net.predict(x))}
     return net
 
 

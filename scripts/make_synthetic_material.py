@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -25,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pydem.calibration import synthetic  # noqa: E402
-from pydem.calibration.setup import load_setup  # noqa: E402
+from pydem.calibration.setup import DEFAULT_STORES, TINY_STORES, load_setup  # noqa: E402
 
 
 def main() -> int:
@@ -41,18 +40,16 @@ def main() -> int:
     ap.add_argument("--journal", help="take the rigs' values and the truth from this diagnosis_dem_sets.py journal")
     ap.add_argument("--set", type=int, default=0, help="the journal's line (0-based)")
     a = ap.parse_args()
-    stores = [ROOT / f"data/campaigns/diag_{r}_{a.preset}.h5" for r in ("ring_shear", "aor", "hopper")]
+    # the shipped store sets as pydem diagnose loads them (the default angle of repose pools the
+    # JKU runs): another set would train, and cache over, differently pooled nets
+    shipped = {"default": DEFAULT_STORES, "tiny": TINY_STORES}
+    stores = [ROOT / s for s in shipped[a.preset]] if a.preset in shipped else \
+        [ROOT / f"data/campaigns/diag_{r}_{a.preset}.h5" for r in ("ring_shear", "aor", "hopper")]
     setup = load_setup([s for s in stores if s.exists()])
     rng = np.random.default_rng(a.seed)
     if a.journal:
-        from pydem.calibration.quantities import Observation, Quantity
         row = json.loads(Path(a.journal).read_text().splitlines()[a.set])
-        t = row["truth"]
-        truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
-        kept = [r for r in row["rows"] if r["value"] is not None]
-        obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
-        obs = synthetic.with_lab_noise(obs, {i: r["value"] for i, r in enumerate(kept)}, setup.nets, rng,
-                                       synthetic.row_inputs(setup.nets, setup.candidates, truth, obs))
+        truth, obs = synthetic.journal_set(row, setup.nets, setup.candidates, rng)
         a.effect, a.strength = truth.effect, truth.strength
     else:
         theta = {k: float(v) for k, v in (kv.split("=") for kv in a.theta.split(","))}

@@ -218,11 +218,11 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         mjs[c.name] = mje
         # the noise model at the base optimum (the candidate neutral), so that LR compares two
         # chi^2 of nearly one quadratic form (base.chi2 has it at the first-pass optimum)
-        at = np.append(base.best, c.neutral_value(base.as_dict()))
+        neutral = c.neutral_value(base.as_dict())
+        at = np.append(base.best, neutral)
         m = Model(observations, nets, ranges, covered, c, at=at)
         f = minimise(m, start=at)
         lr = max(base.chi2 - f.chi2, 0.0)
-        neutral = c.neutral_value(base.as_dict())
         p = float(stats.chi2.sf(lr, 1))
         if c.side == "+":  # P(T >= t) of the 50:50 mixture of 0 and chi^2_1: 1 at t = 0
             p = 0.5 * p if lr > 1e-9 and f.best[-1] > neutral else 1.0

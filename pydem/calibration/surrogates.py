@@ -83,8 +83,7 @@ class QuantityNet:
         x = np.atleast_2d(x)
         if self.err_c is None:
             return np.full(len(x), self.rmse)
-        s = np.clip((x - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0, -1.0, 1.0)
-        return np.clip(np.exp(self.err_c0 + s @ self.err_c), self.rmse / ERROR_SPAN, self.rmse * ERROR_SPAN)
+        return np.clip(np.exp(self.err_c0 + self.scaled(x, clip=True) @ self.err_c), self.rmse / ERROR_SPAN, self.rmse * ERROR_SPAN)
 
     def errors_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(seed scatter, net error), each (m,), at inputs x: the total sd there split as seed_sd and
@@ -95,9 +94,13 @@ class QuantityNet:
         seed = np.minimum(self.scatter, t) if np.isfinite(self.scatter) else t
         return seed, np.sqrt(np.maximum(t * t - seed * seed, (0.2 * t) ** 2))
 
+    def scaled(self, x: np.ndarray, clip: bool = False) -> np.ndarray:
+        """Inputs mapped to the net's [-1, 1] box (clip: held inside it, for the error model)."""
+        s = (np.atleast_2d(x) - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
+        return np.clip(s, -1.0, 1.0) if clip else s
+
     def _hidden(self, x: np.ndarray):
-        s = (x - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
-        return np.tanh(s @ self.w1.T + self.b1)
+        return np.tanh(self.scaled(x) @ self.w1.T + self.b1)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """x: (m, inputs) -> (m,)"""
@@ -147,12 +150,13 @@ def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prio
     """log sd(x) = c0 + c . s(x) (s: the net's scaled inputs) by maximum a posteriori on the
     cross-validated residuals r_i ~ N(0, sd(x_i)^2), each c_j with a N(0, prior_sd^2) prior (a
     one-unit step of a scaled input changes the sd by ~exp(0.5) at most, unless the residuals
-    insist). Why: a net's error is not one number over the box — the ring-shear nets miss by ~5x
-    more at high cohesion and low pre-shear than at a free-flowing point, and one pooled RMSE
-    made every free-flowing material's rows look 2-3x less certain than they are (chi^2/dof 0.2
-    on the shipped synthetic material). The objective is convex."""
+    insist). Why: a net's error is not one number over the box — on the default stores the
+    ring-shear bulk density's sd is 67 kg/m^3 at the top cohesion and lowest pre-shear against 15
+    at a free-flowing mid-box point, the angle of repose's 8.6 against 3.0 deg — and one pooled
+    RMSE makes a free-flowing material's rows look 2-4x less certain than they are
+    (docs/diagnosis.md §3). The objective is convex."""
     from scipy import optimize
-    s = np.clip((np.atleast_2d(x) - net.lo) * (2.0 / (net.hi - net.lo)) - 1.0, -1.0, 1.0)
+    s = net.scaled(x, clip=True)
     r2 = np.asarray(residuals, dtype=float) ** 2
     ok = np.isfinite(r2) & np.all(np.isfinite(s), axis=1)
     s, r2 = s[ok], r2[ok]

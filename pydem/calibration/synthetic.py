@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation, rig_metric, test_conditions
+from .quantities import Observation, Quantity, rig_metric, test_conditions
 
 NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
          "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
@@ -227,6 +227,19 @@ def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth,
     kept = [obs[i] for i in keep]
     return with_lab_noise(kept, {k: values[i] for k, i in enumerate(keep)}, nets, rng,
                           row_inputs(nets, candidates, truth, kept))
+
+
+def journal_set(row: dict, nets: dict, candidates: list[Candidate], rng: np.random.Generator,
+                keep=None) -> tuple[Truth, list[Observation]]:
+    """A set from a bench/diagnosis_dem_sets.py journal line (the rigs' raw values and the truth):
+    its truth and its rows with lab noise drawn now (rows whose run failed, or that `keep`
+    rejects, left out)."""
+    t = row["truth"]
+    truth = Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
+    kept = [r for r in row["rows"] if r["value"] is not None and (keep is None or keep(r))]
+    obs = [Observation(Quantity(r["rig"], r["metric"]), r["conditions"], math.nan, math.nan, r["label"]) for r in kept]
+    return truth, with_lab_noise(obs, {i: r["value"] for i, r in enumerate(kept)}, nets, rng,
+                                 row_inputs(nets, candidates, truth, obs))
 
 
 def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):
