@@ -211,23 +211,27 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
         covered_for_tests = covered
     say(f"  base model: chi^2/dof {base.chi2_per_dof:.2f} (p = {base.p_value:.2g}, {n} rows)")
     results, mjs = [], {}
+    # every likelihood ratio compares two chi^2 of one quadratic form: the noise model at the base
+    # optimum (base.chi2 has it at the first-pass optimum), the base refitted with it
+    ref = base
+    if covered_for_tests:
+        ref_model = Model(observations, nets, ranges, covered, at=base.best)
+        ref = minimise(ref_model, starts=256, keep=2, start=base.best)
     for c in covered_for_tests:
         s, step, mje = _score(base_model, base, c.parameter)
         if c.side == "+" and step < 0:  # one-sided: a step to unphysical values scores nothing
             s = 0.0
         mjs[c.name] = mje
-        # the noise model at the base optimum (the candidate neutral), so that LR compares two
-        # chi^2 of nearly one quadratic form (base.chi2 has it at the first-pass optimum)
         neutral = c.neutral_value(base.as_dict())
-        at = np.append(base.best, neutral)
-        m = Model(observations, nets, ranges, covered, c, at=at)
+        at = np.append(ref.best, neutral)  # the nested model's optimum: the refit never fits worse
+        m = Model(observations, nets, ranges, covered, c, at=np.append(base.best, neutral))
         f = minimise(m, start=at)
-        lr = max(base.chi2 - f.chi2, 0.0)
+        lr = max(ref.chi2 - f.chi2, 0.0)
         p = float(stats.chi2.sf(lr, 1))
         if c.side == "+":  # P(T >= t) of the 50:50 mixture of 0 and chi^2_1: 1 at t = 0
             p = 0.5 * p if lr > 1e-9 and f.best[-1] > neutral else 1.0
         res = CandidateResult(c.name, c.parameter, c.unit, c.side, neutral, float(s), float(step), float(lr), p,
-                              float(f.bic - base.bic), float(f.best[-1]), fit=f)
+                              float(f.bic - ref.bic), float(f.best[-1]), fit=f)
         results.append(res)
         say(f"  {c.name:16s} LR {lr:8.2f}  p {p:9.2g}  dBIC {res.delta_bic:8.2f}  score {s:8.2f}  "
             f"estimate {res.estimate:.4g} {c.unit}")

@@ -3,8 +3,8 @@
 Trained once per campaign store (nn.mlp.bagged_net: the mean of BAG tanh MLPs trained with SCG
 on all runs, itself one wider net; the members' hidden size the one of SIZES with the lowest
 FOLDS-fold cross-validated RMSE; a positive quantity learnt as its log where that RMSE is lower)
-and cached next to the store as plain arrays (`<store>.nets/`, keyed by
-a hash of the store's runs), so a diagnosis loads them in milliseconds and gets the same
+and cached next to the store as plain arrays (`<store>.nets/<hash>/`, keyed by
+a hash of the runs trained on), so a diagnosis loads them in milliseconds and gets the same
 numbers on every machine. Evaluation and Jacobians are numpy (one hidden layer: the Jacobian
 is analytic).
 
@@ -231,8 +231,26 @@ def store_hash(store, pooled=()) -> str:
     return h.hexdigest()[:16]
 
 
+SLOTS = 3  # trained sets kept per store: its own runs, with and without the stores pooled with it, ...
+
+
 def cache_dir(store) -> Path:
+    """Where a store's trained nets live: one sub-folder per training set (store_hash), so that the
+    same store loaded alone and pooled with another does not retrain over the other's nets."""
     return store.path.with_name(store.path.name + ".nets")
+
+
+def _prune_slots(d: Path, keep: Path):
+    """The SLOTS most recently written training sets stay; older ones and the flat layout that kept
+    one set per store (before 2026-11-25) go."""
+    for old in list(d.glob("*.npz")) + [d / "store_hash.txt"]:
+        old.unlink(missing_ok=True)
+    slots = sorted((p for p in d.iterdir() if p.is_dir() and (p / "store_hash.txt").exists()),
+                   key=lambda p: (p != keep, -(p / "store_hash.txt").stat().st_mtime))
+    for old in slots[SLOTS:]:
+        for f in old.iterdir():
+            f.unlink()
+        old.rmdir()
 
 
 def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
@@ -276,8 +294,8 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
 def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Quantity, QuantityNet]:
     """The store's nets from its cache when they were trained on exactly these runs (its own and
     those of the stores pooled with it, pooled_runs.py), else trained now and cached."""
-    d = cache_dir(store)
     key = store_hash(store, pooled)
+    d = cache_dir(store) / key
     stamp = d / "store_hash.txt"
     if not retrain and stamp.exists() and stamp.read_text().strip() == key:
         nets = {}
@@ -304,10 +322,11 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
         n.test_correlation = test_correlation(store, n)
         if n.test_correlation:
             say(f"  {q.key:28s} errors of one run's points correlated {n.test_correlation:.2f}")
-    d.mkdir(exist_ok=True)
+    d.mkdir(parents=True, exist_ok=True)
     for old in d.glob("*.npz"):
         old.unlink()
     for q, n in nets.items():
         np.savez(d / f"{q.metric}.npz", **n.to_arrays())
     stamp.write_text(key + "\n")
+    _prune_slots(d.parent, d)
     return nets
