@@ -241,7 +241,7 @@ def cache_dir(store) -> Path:
 
 
 def _prune_slots(d: Path, keep: Path):
-    """The SLOTS most recently written training sets stay; older ones and the flat layout that kept
+    """The SLOTS most recently used training sets stay; older ones and the flat layout that kept
     one set per store (before 2026-11-25) go."""
     for old in list(d.glob("*.npz")) + [d / "store_hash.txt"]:
         old.unlink(missing_ok=True)
@@ -298,6 +298,10 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
     d = cache_dir(store) / key
     stamp = d / "store_hash.txt"
     if not retrain and stamp.exists() and stamp.read_text().strip() == key:
+        try:
+            stamp.touch()  # recently used: the last set _prune_slots lets go
+        except OSError:
+            pass  # a read-only checkout
         nets = {}
         for f in sorted(d.glob("*.npz")):
             with np.load(f) as a:

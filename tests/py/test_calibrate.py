@@ -199,3 +199,29 @@ def test_command_line_errors_are_clear(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pydem", "calibrate", str(good), "--material", "x",
                         "--stores", str(tmp_path / "none.h5")], cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 2 and "none.h5: no such campaign store" in r.stderr
+
+
+def test_nets_cached_per_training_set(tmp_path, monkeypatch):
+    """A store's nets are cached per set of runs trained on: loading it pooled with another store
+    and alone again retrains neither time after the first; the oldest of more than SLOTS sets goes."""
+    import shutil
+    from pydem.calibration import surrogates
+    from pydem.campaign import Campaign
+    shutil.copy(ROOT / "data/campaigns/ring_shear_cell.h5", tmp_path)
+    shutil.copytree(ROOT / "data/campaigns/ring_shear_cell.h5.nets", tmp_path / "ring_shear_cell.h5.nets")
+    store = Campaign.open(tmp_path / "ring_shear_cell.h5").store
+    shipped = surrogates.load_or_train(store, say=lambda *_: None)
+    trained = []
+    monkeypatch.setattr(surrogates, "train", lambda st, say, pooled=(): trained.append(len(pooled)) or dict(shipped))
+    assert surrogates.load_or_train(store, say=lambda *_: None).keys() == shipped.keys() and trained == []
+    surrogates.load_or_train(store, say=lambda *_: None, pooled=(store,))
+    assert trained == [1]
+    surrogates.load_or_train(store, say=lambda *_: None, pooled=(store,))
+    surrogates.load_or_train(store, say=lambda *_: None)
+    assert trained == [1]  # both sets cached side by side; the store alone the more recently used
+    for k in (2, 3):
+        surrogates.load_or_train(store, say=lambda *_: None, pooled=(store,) * k)
+    slots = [p for p in surrogates.cache_dir(store).iterdir() if p.is_dir()]
+    assert trained == [1, 2, 3] and len(slots) == surrogates.SLOTS
+    names = {p.name for p in slots}
+    assert surrogates.store_hash(store) in names and surrogates.store_hash(store, (store,)) not in names
