@@ -14,8 +14,9 @@ import numpy as np
 from ..campaign.runner import resolved_config
 from ..rigs.config import get_value
 
-# knobs that do not change a run's physics
-_NOT_PHYSICS = {"num_threads", "frame_interval"}
+# knobs that do not change a run's physics (max_overlap_ratio only stops a blown-up run: every
+# run that stays below it is the same, and a run that stops leaves no values)
+_NOT_PHYSICS = {"num_threads", "frame_interval", "max_overlap_ratio"}
 
 
 class PoolError(ValueError):

@@ -173,9 +173,11 @@ def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prio
     net.err_c0, net.err_c = float(res.x[0]), res.x[1:].copy()
 
 
-def replicate_store_path(store) -> Path:
-    """Where a store's seed-scatter companion lives: <name>_replicates.h5 next to it."""
-    return store.path.with_name(store.path.stem + "_replicates.h5")
+def replicate_store_path(store, pooled=()) -> Path | None:
+    """Where a store's seed-scatter companion lives: <name>_replicates.h5 next to it, else that of
+    the first store pooled with it that has one (same rig and preset); None if none has."""
+    paths = (st.path.with_name(st.path.stem + "_replicates.h5") for st in (store, *pooled))
+    return next((p for p in paths if p.exists()), None)
 
 
 def seed_scatter(store) -> dict[Quantity, float]:
@@ -220,8 +222,8 @@ def test_correlation(store, net: QuantityNet) -> float:
 def store_hash(store, pooled=()) -> str:
     h = hashlib.sha256()
     h.update(f"nets {NET_FORMAT} bag {BAG} folds {FOLDS} sizes {SIZES} error span {ERROR_SPAN}".encode())
-    rep = replicate_store_path(store)
-    if rep.exists():
+    rep = replicate_store_path(store, pooled)
+    if rep is not None:
         h.update(rep.read_bytes())
     for st in (store, *pooled):
         h.update(st.spec.to_json().encode())
@@ -315,8 +317,8 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
     extra = "".join(f" + {(o.status == 1).sum()} of {o.path.name}" for o in pooled)
     say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs{extra}; cached in {d})")
     nets = train(store, say, pooled)
-    rep = replicate_store_path(store)
-    if rep.exists():
+    rep = replicate_store_path(store, pooled)
+    if rep is not None:
         from ..campaign import Campaign
         for q, sd in seed_scatter(Campaign.open(rep).store).items():
             if q in nets:

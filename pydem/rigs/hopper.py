@@ -67,6 +67,8 @@ class HopperConfig:
     psd_sizes: list = knob([], 1e-6, 1.0, "m", "size table: sieve sizes, increasing (replaces the two species; packing A)")
     psd_passing: list = knob([], 0.0, 1.0, "", "size table: cumulative mass fraction passing each size, 0 ... 1")
     fine_fraction: float = knob(0.3, 0.0, 1.0, "", "volume fraction of fine spheres (Phi_s)")
+    size_spread: float = knob(0.0, 0.0, 0.5, "", "each species' diameters uniform in d (1 +- spread) "
+                              "(0: the two sizes exactly; replaced by a size table)")
     packing: str = knob("A", doc="initial packing: A mixed, B1-B4 layered", choices=PACKINGS)
     top_width: float = knob(0.2, 0.01, 5.0, "m", "width of the vertical section")
     slot_width: float = knob(0.054, 1e-3, 1.0, "m", "outlet slot width b")
@@ -93,7 +95,9 @@ class HopperConfig:
     @property
     def largest(self) -> float:
         """The largest sphere diameter: the coarse species', or the size table's top size."""
-        return max(self.d_small, self.d_large, *(self.psd_sizes[-1:] or []))
+        if len(self.psd_sizes):
+            return max(self.d_small, self.d_large, self.psd_sizes[-1])
+        return max(self.d_small, self.d_large) * (1.0 + self.size_spread)
 
     def on_set(self, key: str):
         """Setting `case` loads its Table 1 values; keys set after it override them."""
@@ -304,7 +308,10 @@ class Hopper:
             return diam < 0.5 * (c.psd_sizes[0] + c.psd_sizes[-1]), diam
         n_fine, n_coarse = species_counts(c.particles, c.d_small, c.d_large, c.fine_fraction)
         order = self._filling_order(rng, n_fine, n_coarse)
-        return order, np.where(order, c.d_small, c.d_large)
+        diam = np.where(order, c.d_small, c.d_large)
+        if c.size_spread > 0.0:  # no draw at 0: the two-size runs stay as they were
+            diam = diam * (1.0 + c.size_spread * rng.uniform(-1.0, 1.0, len(diam)))
+        return order, diam
 
     def _filling_order(self, rng, n_fine: int, n_coarse: int) -> np.ndarray:
         fine, coarse = np.ones(n_fine, bool), np.zeros(n_coarse, bool)

@@ -60,6 +60,26 @@ def test_layered_packings_order():
     assert list(order) == [True] * 5 + [False] * 4 + [True] * 5
 
 
+def test_size_spread_widens_each_species_and_leaves_two_sizes_alone():
+    """size_spread s: each species' diameters uniform in d (1 +- s) (mean d, the bounds exact);
+    at 0 no random draw is taken, so every run of the two-size hopper stays bitwise as it was."""
+    plain = Hopper(load(HopperConfig, "default"))
+    rng = np.random.default_rng(5)
+    fine, diam = plain._pouring_order(rng)
+    assert set(diam[fine]) == {6e-3} and set(diam[~fine]) == {9e-3}
+    ref = np.random.default_rng(5)
+    Hopper(load(HopperConfig, "default"))._filling_order(ref, int(fine.sum()), int((~fine).sum()))
+    assert np.random.default_rng(5).bit_generator.state != ref.bit_generator.state
+    assert rng.bit_generator.state == ref.bit_generator.state  # the order's draws and nothing else
+    wide = Hopper(load(HopperConfig, "default", overrides=["size_spread=0.4"]))
+    fine, diam = wide._pouring_order(np.random.default_rng(5))
+    for d0, sel in ((6e-3, fine), (9e-3, ~fine)):
+        rel = diam[sel] / d0 - 1.0
+        assert rel.min() >= -0.4 and rel.max() <= 0.4 and rel.max() - rel.min() > 0.7  # fills the band
+        assert abs(rel.mean()) < 4 * 0.4 / math.sqrt(3 * sel.sum())  # uniform: mean d within 4 sd
+    assert wide.config.largest == pytest.approx(9e-3 * 1.4)
+
+
 def test_beverloo_fit_recovers_constants():
     C, k, rho, L, d = 1.0, 1.5, 1500.0, 0.04, 0.006
     b = np.array([0.03, 0.04, 0.05, 0.06, 0.08])
