@@ -18,3 +18,8 @@ for rig in hopper aor ring_shear; do
         .venv/bin/pydem campaign run data/campaigns/$name.toml --store data/campaigns/$name.h5 --workers "$workers"
     done
 done
+if [ "$preset" = default ]; then  # the hopper's size-spread runs (the two-size runs above pooled into them)
+    echo "== diag_hopper_default_spread"
+    .venv/bin/pydem campaign run data/campaigns/diag_hopper_default_spread.toml \
+        --store data/campaigns/diag_hopper_default_spread.h5 --workers "$workers"
+fi
