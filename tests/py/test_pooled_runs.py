@@ -19,8 +19,8 @@ BOX = {"friction": (0.05, 1.0), "rolling_friction": (0.0, 0.6), "restitution": (
 THREE = {"friction": (0.2, 1.0), "rolling_friction": (0.05, 0.6), "restitution": (0.2, 0.9)}
 
 
-def store(name, ranges, params, values, preset="tiny", fixed=None, protocol=1, libdem="0.2.0"):
-    spec = CampaignSpec("aor", dict(ranges), preset, dict(fixed or {}))
+def store(name, ranges, params, values, preset="tiny", fixed=None, protocol=1, libdem="0.2.0", rig="aor"):
+    spec = CampaignSpec(rig, dict(ranges), preset, dict(fixed or {}))
     prov = {"rig_protocol": protocol, "libdem": libdem, "rig_config": resolved_config(spec)}
     return SimpleNamespace(spec=spec, path=Path(name), params=np.asarray(params, float), provenance=prov,
                            rig_protocol=protocol, physics=".".join(libdem.split(".")[:2]),
@@ -59,3 +59,15 @@ def test_a_store_varying_more_than_the_main_one_is_refused():
     wide = store("other.h5", {**THREE, "particles": (500, 700)}, [[0.3, 0.1, 0.4, 600]], [[30.0, 1490.0]])
     with pytest.raises(PoolError, match="varies particles"):
         check_poolable(main, wide)
+
+
+def test_a_different_blow_up_limit_does_not_block_pooling():
+    """max_overlap_ratio only stops a run that blew up (every run below it is the same): stores that
+    differ in it pool; the thread count likewise."""
+    main = store("six.h5", BOX, [[0.5, 0.3, 0.5, 0.4, 2e4, 0.2]], [[35.0, 1500.0]],
+                 fixed={"max_overlap_ratio": 0.6, "num_threads": 2}, rig="hopper")
+    other = store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]], rig="hopper")
+    check_poolable(main, other)
+    with pytest.raises(PoolError, match="the rig differs in fine_fraction"):
+        check_poolable(main, store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]], rig="hopper",
+                                   fixed={"fine_fraction": 0.5}))
