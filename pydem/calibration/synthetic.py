@@ -76,8 +76,11 @@ class Truth:
 def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidate], effect: str | None,
                min_fraction: float = 0.2) -> Truth:
     """Base parameters uniform in the box; the effect's parameter uniform between
-    `min_fraction` of the way from neutral to the range edge and that edge (a random side for
-    two-sided candidates), so an effect is never drawn vanishingly small."""
+    `min_fraction` of the way from neutral to the range edge and that edge, so an effect is never
+    drawn vanishingly small. A two-sided candidate's side is drawn in proportion to the room on
+    it (size spread: 0.4 above the neutral 0.1, 0.1 below), so the strength is near-uniform over
+    the campaign range, as a material's would be (an even coin gave half of the size-spread sets
+    a spread of 0-0.1: the three DEM sets of 2026-11-24 all landed there)."""
     theta = {n: float(rng.uniform(*ranges[n])) for n in BASE_PARAMETERS}
     if effect is None:
         return Truth(theta, None, None, None)
@@ -85,8 +88,9 @@ def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidat
     lo, hi = ranges[c.parameter]
     neutral = c.neutral_value(theta)
     neutral = min(max(neutral, lo), hi)
-    sides = [+1] if c.side == "+" else [+1, -1]
-    side = sides[int(rng.integers(len(sides)))]
+    side = +1
+    if c.side != "+" and hi - lo > 0:  # one-sided: no draw (its truths stay as they were)
+        side = +1 if rng.uniform() * (hi - lo) < hi - neutral else -1
     edge = hi if side > 0 else lo
     if abs(edge - neutral) < 1e-12 * max(1.0, abs(edge)):
         edge = lo if side > 0 else hi
