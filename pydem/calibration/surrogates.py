@@ -244,7 +244,7 @@ def cache_dir(store) -> Path:
 
 def _prune_slots(d: Path, keep: Path):
     """The SLOTS most recently used training sets stay; older ones and the flat layout that kept
-    one set per store (before 2026-11-25) go."""
+    one set per store (until 2026-11-24) go."""
     for old in list(d.glob("*.npz")) + [d / "store_hash.txt"]:
         old.unlink(missing_ok=True)
     slots = sorted((p for p in d.iterdir() if p.is_dir() and (p / "store_hash.txt").exists()),
