@@ -21,9 +21,11 @@ from .surrogates import load_or_train
 TINY_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_aor_tiny.h5",
                "data/campaigns/diag_hopper_tiny.h5")
 # (aor_jku.h5: seed 000's three-parameter angle-of-repose campaign, pooled into the angle-of-repose
-# surrogates: its runs are points of the diagnosis box, pooled_runs.py)
+# surrogates; diag_hopper_default.h5: the hopper's two-size runs, pooled into its size-spread store;
+# their runs are points of the diagnosis box, pooled_runs.py)
 DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/diag_aor_default.h5",
-                  "data/campaigns/aor_jku.h5", "data/campaigns/diag_hopper_default.h5")
+                  "data/campaigns/aor_jku.h5", "data/campaigns/diag_hopper_default_spread.h5",
+                  "data/campaigns/diag_hopper_default.h5")
 
 
 @dataclass
