@@ -12,14 +12,11 @@ cd "$(dirname "$0")/.."
 preset=${1:-tiny}
 workers=${2:-2}
 for rig in hopper aor ring_shear; do
-    for kind in "" _replicates; do
-        name=diag_${rig}_${preset}${kind}
+    # every diagnosis store of the rig at this preset: the main one, its replicates, and any
+    # companion (the default hopper's size-spread store, into which its two-size runs pool)
+    for toml in data/campaigns/diag_${rig}_${preset}*.toml; do
+        name=$(basename "$toml" .toml)
         echo "== $name"
-        .venv/bin/pydem campaign run data/campaigns/$name.toml --store data/campaigns/$name.h5 --workers "$workers"
+        .venv/bin/pydem campaign run "$toml" --store data/campaigns/$name.h5 --workers "$workers"
     done
 done
-if [ "$preset" = default ]; then  # the hopper's size-spread runs (the two-size runs above pooled into them)
-    echo "== diag_hopper_default_spread"
-    .venv/bin/pydem campaign run data/campaigns/diag_hopper_default_spread.toml \
-        --store data/campaigns/diag_hopper_default_spread.h5 --workers "$workers"
-fi

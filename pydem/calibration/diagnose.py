@@ -223,9 +223,8 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
             s = 0.0
         mjs[c.name] = mje
         neutral = c.neutral_value(base.as_dict())
-        at = np.append(ref.best, neutral)  # the nested model's optimum: the refit never fits worse
         m = Model(observations, nets, ranges, covered, c, at=np.append(base.best, neutral))
-        f = minimise(m, start=at)
+        f = minimise(m, start=np.append(ref.best, neutral))  # the nested optimum: never fits worse than ref
         lr = max(ref.chi2 - f.chi2, 0.0)
         p = float(stats.chi2.sf(lr, 1))
         if c.side == "+":  # P(T >= t) of the 50:50 mixture of 0 and chi^2_1: 1 at t = 0

@@ -24,7 +24,7 @@ from .. import geometry
 from ..domain import Domain
 from ..walls import MeshWall
 from .checkpoint import Checkpoint, CheckpointStop, signature
-from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, stable_dt
+from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult
 
@@ -94,7 +94,8 @@ class HopperConfig:
 
     @property
     def largest(self) -> float:
-        """The largest sphere diameter: the coarse species', or the size table's top size."""
+        """The largest sphere diameter: the coarse species' (widened by the size spread), or the size
+        table's top size."""
         if len(self.psd_sizes):
             return max(self.d_small, self.d_large, self.psd_sizes[-1])
         return max(self.d_small, self.d_large) * (1.0 + self.size_spread)
@@ -310,7 +311,7 @@ class Hopper:
         order = self._filling_order(rng, n_fine, n_coarse)
         diam = np.where(order, c.d_small, c.d_large)
         if c.size_spread > 0.0:  # no draw at 0: the two-size runs stay as they were
-            diam = diam * (1.0 + c.size_spread * rng.uniform(-1.0, 1.0, len(diam)))
+            diam = 2.0 * size_distribution(rng, len(diam), diam, c.size_spread)  # radii -> diameters
         return order, diam
 
     def _filling_order(self, rng, n_fine: int, n_coarse: int) -> np.ndarray:

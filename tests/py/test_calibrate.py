@@ -203,7 +203,8 @@ def test_command_line_errors_are_clear(tmp_path):
 
 def test_nets_cached_per_training_set(tmp_path, monkeypatch):
     """A store's nets are cached per set of runs trained on: loading it pooled with another store
-    and alone again retrains neither time after the first; the oldest of more than SLOTS sets goes."""
+    and alone again retrains neither time after the first; the least recently used of more than
+    SLOTS sets goes."""
     import shutil
     from pydem.calibration import surrogates
     from pydem.campaign import Campaign
