@@ -63,7 +63,7 @@ class Model:
             if self.at is not None and hasattr(n, "errors_at"):
                 a, b = n.errors_at(self.row_inputs(k, self.at))
                 seed[k], err[k] = a[0], b[0]
-                sigma[k] = np.sqrt(max(o.uncertainty, seed[k]) ** 2 + err[k] ** 2)
+                sigma[k] = n.row_sigma(o.uncertainty, seed[k], err[k])
             else:
                 seed[k], err[k] = getattr(n, "seed_sd", 0.0), getattr(n, "net_error", 0.0)
                 sigma[k] = n.row_sigma(o.uncertainty)
