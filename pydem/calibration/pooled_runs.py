@@ -11,12 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..campaign.runner import resolved_config
+from ..campaign.runner import NOT_PHYSICS, resolved_config
 from ..rigs.config import get_value
-
-# knobs that do not change a run's physics (max_overlap_ratio only stops a blown-up run: every
-# run that stays below it is the same, and a run that stops leaves no values)
-_NOT_PHYSICS = {"num_threads", "frame_interval", "max_overlap_ratio"}
 
 
 class PoolError(ValueError):
@@ -43,7 +39,7 @@ def check_poolable(main, other) -> None:
     varied = {k.split(".")[-1] for k in list(main.spec.ranges) + list(other.spec.ranges)}
     a = main.provenance.get("rig_config") or resolved_config(main.spec)
     b = other.provenance.get("rig_config") or resolved_config(other.spec)
-    differ = [k for k in sorted(set(a) & set(b)) if k not in _NOT_PHYSICS and k != "params.effects"
+    differ = [k for k in sorted(set(a) & set(b)) if k not in NOT_PHYSICS and k != "params.effects"
               and k.split(".")[-1] not in varied and a[k] != b[k]]
     if differ:
         raise PoolError(f"{where}: the rig differs in " + ", ".join(f"{k} ({b[k]} vs {a[k]})" for k in differ))

@@ -269,6 +269,16 @@ def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]
     return out
 
 
+def model_error(model, fit, clean: dict[int, float]) -> float | None:
+    """RMSE of the fitted model's relative errors against the set's noise-free values (the truth's
+    net values, no seed scatter, no lab noise): what the model gets wrong about the material, which
+    a measured set's residuals show only mixed with the noise (None without a fit)."""
+    if fit is None or len(model.y) != len(clean):
+        return None
+    v = np.array([clean[i] for i in range(len(clean))])
+    return float(np.sqrt(np.mean(((v - model.predict(fit.best)) / v) ** 2)))
+
+
 SIGNAL_VISIBLE = 15.0  # the noncentrality at which the one-sided LR test at p = 0.01 has 94 % power
 SIGNAL_BINS = ((0.0, 5.0), (5.0, 15.0), (15.0, 50.0), (50.0, math.inf))
 
@@ -289,6 +299,8 @@ def score_sets(results: list[dict]) -> dict:
         else:
             hit = [r for r in rows if r["effect"] == kind]
             falls = [r["rmse_after"] / r["rmse_before"] for r in hit if r["rmse_after"] is not None and r["rmse_before"] > 0]
+            truth_falls = [r["truth_error_after"] / r["truth_error_before"] for r in hit
+                           if r.get("truth_error_after") is not None and r["truth_error_before"] > 0]
             seen = [r for r in rows if (r.get("signal") or 0.0) >= SIGNAL_VISIBLE]
             out[kind] = {"sets": n, "top1": len(hit), "top1_rate": len(hit) / n,
                          "visible_sets": len(seen), "top1_visible": sum(r["effect"] == kind for r in seen),
@@ -298,6 +310,7 @@ def score_sets(results: list[dict]) -> dict:
                                        for b in [[r for r in rows if r.get("signal") is not None and lo <= r["signal"] < hi]]},
                          "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})},
                          "error_after_over_before_median": float(np.median(falls)) if falls else None,
+                         "truth_error_after_over_before_median": float(np.median(truth_falls)) if truth_falls else None,
                          "chi2_per_dof_after_median": float(np.median([r["chi2_after"] for r in hit])) if hit else None}
     return out
 
@@ -335,6 +348,11 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
             visible = signal(setup, truth, obs) if source == "surrogate" else None
             d = diagnose(f"{kind}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
             s_before, s_after = d.summary_of(d.base, d.base_model), d.summary_of(d.after, d.after_model)
+            truth_error = {"before": None, "after": None}
+            if source == "surrogate" and kind != "unexplained":
+                clean = surrogate_values(setup.nets, setup.candidates, truth, obs)
+                truth_error = {"before": model_error(d.base_model, d.base, clean),
+                               "after": model_error(d.after_model, d.after, clean)}
             row = {"kind": kind, "set": k, "source": source, "truth": truth.theta, "effect_truth": truth.effect,
                    "strength": truth.strength, "signal": visible, "verdict": d.verdict, "effect": d.effect,
                    "best_candidate": d.candidates[0].effect if d.candidates else None,
@@ -342,7 +360,8 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                    "chi2_before": s_before["chi2_per_dof"], "rmse_before": s_before["rmse_relative"],
                    "chi2_after": s_after["chi2_per_dof"] if s_after else None,
                    "rmse_after": s_after["rmse_relative"] if s_after else None,
-                   "loco_before": d.loco.get("before"), "loco_after": d.loco.get("after")}
+                   "loco_before": d.loco.get("before"), "loco_after": d.loco.get("after"),
+                   "truth_error_before": truth_error["before"], "truth_error_after": truth_error["after"]}
             rows.append(row)
             if journal is not None:
                 with open(journal, "a") as fh:

@@ -78,15 +78,21 @@ def resolved_config(spec) -> dict:
             and key.split(".")[-1] not in spec.ranges}
 
 
+# knobs that do not change a run's physics: threads, frames, and max_overlap_ratio, which only
+# stops a blown-up run (every run that stays below it is the same; a run that stops leaves no values)
+NOT_PHYSICS = {"num_threads", "frame_interval", "max_overlap_ratio"}
+
+
 def config_drift(store) -> dict[str, tuple]:
     """{knob: (value when the store was run, value now)} for every knob whose resolution of the
-    store's preset has changed since (the thread count is not the rig). Knobs added after the
-    store was run are left out: a new knob's default keeps the rig as it was."""
+    store's preset has changed since, apart from NOT_PHYSICS (so a raised blow-up bound lets a
+    store retry its stopped runs). Knobs added after the store was run are left out: a new knob's
+    default keeps the rig as it was."""
     then = store.provenance.get("rig_config")
     if not then:
         return {}
     now = resolved_config(store.spec)
-    return {k: (then[k], now.get(k)) for k in sorted(then) if k != "num_threads" and then[k] != now.get(k)}
+    return {k: (then[k], now.get(k)) for k in sorted(then) if k not in NOT_PHYSICS and then[k] != now.get(k)}
 
 
 class Campaign:

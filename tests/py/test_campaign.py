@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from pydem.campaign import Campaign, CampaignSpec, CampaignStore, SpecError, StoreError, design_points, simulate
+from pydem.campaign.runner import config_drift
 from pydem.campaign.store import DONE, FAILED
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -134,6 +135,11 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
     c.store.save()
     with pytest.raises(StoreError, match="'tiny' preset has changed.*lift_speed: 0.05 then, 0.1 now"):
         Campaign.open(tmp_path / "s.h5").run(quiet=True)
+    # a knob that changes no run's physics (the blow-up bound, frames, threads) is no drift: a
+    # raised bound lets a store retry the runs it stopped
+    c.store.provenance["rig_config"]["lift_speed"] = 0.1
+    c.store.provenance["rig_config"].update(max_overlap_ratio=0.3, frame_interval=0.01)
+    assert config_drift(c.store) == {}
     (tmp_path / "junk.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     with pytest.raises(StoreError, match="unreadable campaign store"):
         CampaignStore.open(tmp_path / "junk.h5")
