@@ -14,7 +14,9 @@ scatter and the net's own error together, which is what separates one DEM run (o
 repeat) from the surrogate's smooth mean; the diagnosis adds it to every row's measurement
 uncertainty. A quantity measured at several points of one test (the shear points of one
 ring-shear run) also carries how much those points' errors go together: one specimen, one
-packing (`test_correlation`, measured on the store's runs)."""
+packing (`test_correlation`, measured on the store's runs). The error model (`fit_error_model`)
+says where the error is; the replicate runs say which part of it is seed scatter — one pooled sd,
+or a fixed fraction of the error model's sd where the replicates vary with it (`fit_scatter_ratio`)."""
 from __future__ import annotations
 
 import hashlib
@@ -57,6 +59,9 @@ class QuantityNet:
     err_c0: float = float("nan")
     err_c: np.ndarray | None = None
     log_output: bool = False  # the net learnt log(value) (a positive quantity): f = exp(scaled output)
+    # the seed scatter where the error model is: a fixed fraction of the total sd at a point, when the
+    # replicates say so (fit_scatter_ratio); nan: the pooled `scatter` everywhere
+    scatter_ratio: float = float("nan")
 
     @property
     def seed_sd(self) -> float:
@@ -89,12 +94,16 @@ class QuantityNet:
         return np.clip(np.exp(self.err_c0 + self.scaled(x, clip=True) @ self.err_c), self.rmse / ERROR_SPAN, self.rmse * ERROR_SPAN)
 
     def errors_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(seed scatter, net error), each (m,), at inputs x: the total sd there split as seed_sd and
-        net_error split the RMSE — the replicates' pooled scatter, at most the total sd (the pooled
-        value comes from a few points; where the net's runs scatter less, so does a repeat), and the
-        rest the net's, at least a fifth of the total."""
+        """(seed scatter, net error), each (m,), at inputs x: the seed scatter a fixed fraction of the
+        total sd there where the replicates scatter in step with the error model (scatter_ratio),
+        else their pooled scatter, at most the total sd (the pooled value comes from a few points;
+        where the net's runs scatter less, so does a repeat); the rest the net's, at least a fifth
+        of the total."""
         t = self.total_sd(x)
-        seed = np.minimum(self.scatter, t) if np.isfinite(self.scatter) else t
+        if np.isfinite(self.scatter_ratio):
+            seed = np.minimum(self.scatter_ratio, 1.0) * t
+        else:
+            seed = np.minimum(self.scatter, t) if np.isfinite(self.scatter) else t
         return seed, np.sqrt(np.maximum(t * t - seed * seed, (0.2 * t) ** 2))
 
     def scaled(self, x: np.ndarray, clip: bool = False) -> np.ndarray:
@@ -136,7 +145,7 @@ class QuantityNet:
                                              "b2": self.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
                                              "unit": self.unit, "scatter": self.scatter,
                                              "test_correlation": self.test_correlation, "err_c0": self.err_c0,
-                                             "log_output": self.log_output,
+                                             "log_output": self.log_output, "scatter_ratio": self.scatter_ratio,
                                              "format": NET_FORMAT})),
                 **({"err_c": self.err_c} if self.err_c is not None else {})}
 
@@ -146,7 +155,8 @@ class QuantityNet:
         return cls(Quantity(meta["rig"], meta["metric"]), meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
                    a["w1"], a["b1"], a["w2"], meta["b2"], meta["rmse"], meta["r2"], meta["runs"], meta["unit"],
                    meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0), meta.get("err_c0", float("nan")),
-                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None, meta.get("log_output", False))
+                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None, meta.get("log_output", False),
+                   meta.get("scatter_ratio", float("nan")))
 
 
 def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prior_sd: float = 0.5):
@@ -204,15 +214,80 @@ def seed_scatter(store) -> dict[Quantity, float]:
     return out
 
 
-def test_correlation(store, net: QuantityNet) -> float:
-    """How much one run's errors at its several points (the shear fractions of one ring-shear
-    run) go together: the mean correlation between the net's residuals at two points of the
-    same run, over the store's finished runs (in-sample residuals: seed scatter and the net's
-    misfit, which is what a measurement of the same test shares); clipped to [0, 0.95]; 0 for a
-    quantity measured once per run."""
+def replicate_groups(store, rep, net: QuantityNet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sd, dof, inputs) of every replicated point of `rep` (each shear point its own group) for
+    the net's quantity: the runs' sample sd at the point, its degrees of freedom (runs - 1), and
+    the point's inputs in the net's columns (`rep`'s parameters mapped into `store`'s, as pooling
+    does, plus the shear fraction)."""
+    from .pooled_runs import pooled_params
+    q = net.quantity
+    params = pooled_params(store, rep) if rep.spec.names != store.spec.names else rep.params
+    if q.metric == "mu_ie_s":
+        cols = list(fraction_columns(rep.metric_names))
+    else:
+        cols = [(rep.metric_names.index(q.metric), None)] if q.metric in rep.metric_names else []
+    sd, dof, xs = [], [], []
+    for j, frac in cols:
+        for p in np.unique(rep.points):
+            k = (rep.points == p) & (rep.status == 1) & np.isfinite(rep.values[:, j])
+            if k.sum() < 2:
+                continue
+            x = params[k][0] if frac is None or "shear_fraction" not in net.input_names else np.r_[params[k][0], frac]
+            if len(x) != len(net.input_names):
+                continue
+            sd.append(rep.values[k, j].std(ddof=1))
+            dof.append(k.sum() - 1)
+            xs.append(x)
+    return np.array(sd), np.array(dof, dtype=float), np.array(xs).reshape(len(xs), len(net.input_names))
+
+
+def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.ndarray) -> float:
+    """The seed scatter's shape over the campaign box, from the replicated points: one pooled sd
+    everywhere, or a fixed fraction r of the error model's total sd at each point (a rig scatters
+    more where its runs are hard to predict: on the default ring shear, at low particle and high
+    wall friction, one shear point's runs spread by 0.17 in mu_ie_s, at others by 0.02). Both have
+    one parameter (its maximum-likelihood value from the points' sample variances); the one whose
+    Gaussian likelihood of those variances is higher is kept. Returns r, or nan for the pooled sd
+    (also without replicates or an error model)."""
+    if len(sd) < 3 or net.err_c is None or dof.sum() <= 0:
+        return float("nan")
+    t = net.total_sd(x)
+    v = sd * sd
+
+    def loglik(s2):  # each point's sample variance: dof * v / s2 ~ chi^2(dof)
+        return float(np.sum(-0.5 * dof * (np.log(s2) + v / s2)))
+
+    pooled = np.sum(dof * v) / dof.sum()
+    r2 = np.sum(dof * v / (t * t)) / dof.sum()
+    if pooled <= 0 or loglik(r2 * t * t) <= loglik(np.full(len(v), pooled)):
+        return float("nan")
+    return float(np.sqrt(r2))
+
+
+def test_correlation(store, net: QuantityNet, rep=None) -> float:
+    """How much one run's seed scatter at its several points (the shear fractions of one ring-
+    shear run) goes together, clipped to [0, 0.95]; 0 for a quantity measured once per run. From
+    the replicate store `rep` where it has at least 5 points with 3 or more runs: the mean
+    correlation, between two shear points, of the runs' deviations from their point's mean (each
+    point's and shear point's deviations in units of their sd). Else from the store's runs: the
+    mean correlation of the net's in-sample residuals at two points of one run — an upper bound,
+    as those residuals also carry the net's misfit, smooth over the fraction, which the
+    likelihood already shares between the points (fit.Model)."""
     points = fraction_columns(store.metric_names)
     if "shear_fraction" not in net.input_names or len(points) < 2:
         return 0.0
+    if rep is not None:
+        cols = [j for j, _ in fraction_columns(rep.metric_names)]
+        dev = []
+        for p in np.unique(rep.points):
+            v = rep.values[(rep.points == p) & (rep.status == 1)][:, cols]
+            v = v[np.all(np.isfinite(v), axis=1)]
+            sd = v.std(axis=0, ddof=1) if len(v) >= 3 else np.zeros(len(cols))
+            if len(v) >= 3 and np.all(sd > 0):
+                dev.append((v - v.mean(axis=0)) / sd)
+        if len(dev) >= 5:
+            c = np.corrcoef(np.vstack(dev).T)
+            return float(np.clip(c[np.triu_indices(len(cols), 1)].mean(), 0.0, 0.95))
     cols = np.array([store.values[:, j] - net(np.column_stack([store.params, np.full(len(store.params), frac)]))
                      for j, frac in points]).T
     r = cols[(store.status == 1) & np.all(np.isfinite(cols), axis=1)]
@@ -296,6 +371,17 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
     return nets
 
 
+def replicate_shape(store, pooled, net: QuantityNet) -> tuple[float, float]:
+    """(scatter_ratio, test_correlation) of a net from the store's replicates (replicate_store_path;
+    without them: nan, and the correlation from the store's own runs)."""
+    path = replicate_store_path(store, pooled)
+    if path is None:
+        return float("nan"), test_correlation(store, net)
+    from ..campaign import Campaign
+    rep = Campaign.open(path).store
+    return fit_scatter_ratio(net, *replicate_groups(store, rep, net)), test_correlation(store, net, rep)
+
+
 def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Quantity, QuantityNet]:
     """The store's nets from its cache when they were trained on exactly these runs (its own and
     those of the stores pooled with it, pooled_runs.py), else trained now and cached."""
@@ -311,10 +397,13 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
         for f in sorted(d.glob("*.npz")):
             with np.load(f) as a:
                 n = QuantityNet.from_arrays(a)
-                stale = "test_correlation" not in str(a["meta"])  # cached before it was measured
-            if stale:
-                n.test_correlation = test_correlation(store, n)
-                np.savez(f, **n.to_arrays())
+                meta = str(a["meta"])
+            if "scatter_ratio" not in meta:  # cached before the replicates gave the scatter's shape and correlation
+                n.scatter_ratio, n.test_correlation = replicate_shape(store, pooled, n)
+                try:
+                    np.savez(f, **n.to_arrays())
+                except OSError:
+                    pass  # a read-only checkout: measured again on the next load
             nets[n.quantity] = n
         return nets
     extra = "".join(f" + {(o.status == 1).sum()} of {o.path.name}" for o in pooled)
@@ -328,7 +417,9 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
                 nets[q].scatter = sd
                 say(f"  {q.key:28s} seed scatter {sd:.4g} (from {rep.name})")
     for q, n in nets.items():
-        n.test_correlation = test_correlation(store, n)
+        n.scatter_ratio, n.test_correlation = replicate_shape(store, pooled, n)
+        if np.isfinite(n.scatter_ratio):
+            say(f"  {q.key:28s} seed scatter {n.scatter_ratio:.2f} of the error model's sd (the replicates vary with it)")
         if n.test_correlation:
             say(f"  {q.key:28s} errors of one run's points correlated {n.test_correlation:.2f}")
     d.mkdir(parents=True, exist_ok=True)

@@ -299,6 +299,55 @@ def test_the_error_model_finds_where_the_error_is_and_splits_it():
     assert err[0] == pytest.approx(0.2 * lo_sd) and err[1] == pytest.approx(np.sqrt(hi_sd ** 2 - 0.08 ** 2))
 
 
+def test_the_seed_scatter_follows_the_error_model_when_the_replicates_do():
+    """fit_scatter_ratio: 60 replicated points (4 runs each) whose sd is 0.4 x the error model's
+    total sd (which spans ~7x over the box) give the proportional shape, r within 0.06 of 0.4 (its
+    standard error with 180 degrees of freedom is ~0.021); points with one sd everywhere keep the
+    pooled value (nan); errors_at then splits r x total off as the seed scatter. (With a 3x span
+    and 40 points the two shapes' likelihoods differ by < 1: the choice needs the span.)"""
+    from pydem.calibration.quantities import Quantity
+    from pydem.calibration.surrogates import QuantityNet, fit_scatter_ratio
+    rng = np.random.default_rng(9)
+    net = QuantityNet(Quantity("aor", "angle_of_repose"), ["a", "b"], np.zeros(2), np.ones(2), 0.0, 1.0,
+                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.15, r2=0.5, runs=300,
+                      err_c0=np.log(0.1), err_c=np.array([1.0, 0.0]))
+    x = rng.uniform(0, 1, (60, 2))
+    t = net.total_sd(x)
+    assert t.max() / t.min() > 6
+    for true_sd, proportional in ((0.4 * t, True), (np.full(60, 0.05), False)):
+        runs = true_sd[:, None] * rng.normal(size=(60, 4))
+        r = fit_scatter_ratio(net, runs.std(axis=1, ddof=1), np.full(60, 3.0), x)
+        if proportional:
+            assert abs(r - 0.4) < 0.06, r
+        else:
+            assert np.isnan(r), r
+    net.scatter_ratio = 0.4
+    seed, err = net.errors_at(x[:2])
+    assert seed == pytest.approx(0.4 * t[:2]) and err == pytest.approx(np.sqrt(0.84) * t[:2])
+
+
+def test_the_specimen_correlation_comes_from_the_replicates():
+    """test_correlation from a replicate store: 30 points x 4 runs whose three shear points'
+    seed deviations correlate by 0.6 (each point its own scale) give 0.6 within 0.15 (the mean
+    of three pairwise correlations of 90 deviations: standard error ~0.07); independent ones
+    give at most 0.15 (the estimate is clipped at 0)."""
+    from types import SimpleNamespace
+    from pydem.calibration.quantities import Quantity
+    from pydem.calibration.surrogates import QuantityNet, test_correlation
+    rng = np.random.default_rng(10)
+    names = ["mu_ie_s_30", "mu_ie_s_60", "mu_ie_s_90"]
+    net = QuantityNet(Quantity("ring-shear", "mu_ie_s"), ["a", "shear_fraction"], np.zeros(2), np.ones(2), 0.0, 1.0,
+                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.1, r2=0.5, runs=100)
+    store = SimpleNamespace(metric_names=names)
+    for rho in (0.6, 0.0):
+        cov = np.full((3, 3), rho) + (1 - rho) * np.eye(3)
+        dev = rng.multivariate_normal(np.zeros(3), cov, size=120) * rng.uniform(0.02, 0.2, 30).repeat(4)[:, None]
+        rep = SimpleNamespace(metric_names=names, points=np.arange(30).repeat(4), status=np.ones(120, dtype=int),
+                              values=0.7 + dev)
+        c = test_correlation(store, net, rep)
+        assert (abs(c - 0.6) < 0.15) if rho else (c <= 0.15), (rho, c)
+
+
 def test_a_log_output_quantity_net_has_the_gradient_of_exp():
     """QuantityNet with log_output: f = exp(net) and its analytic gradient matches central
     differences (relative 1e-6: step 1e-6 of the input range, truncation ~1e-12)."""
