@@ -90,9 +90,7 @@ class Model:
             for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):
                 if ni is not nj:
                     continue
-                d2 = sum(((oi.conditions[c] - oj.conditions[c]) * 2.0 / _input_width(ni, c)) ** 2
-                         for c in oi.conditions if c in ni.input_names)
-                cov[i, j] += e[i] * e[j] * np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+                cov[i, j] += e[i] * e[j] * condition_correlation(ni, oi, oj)
                 if i != j and _same_test(oi, oj):
                     cov[i, j] += getattr(ni, "test_correlation", 0.0) * s[i] * s[j]
         return cov
@@ -166,6 +164,14 @@ class Model:
 def _same_test(a: Observation, b: Observation) -> bool:
     """Two points of one test: the same conditions but the shear fraction (one specimen)."""
     return "shear_fraction" in a.conditions and "shear_fraction" in b.conditions and test_conditions(a) == test_conditions(b)
+
+
+def condition_correlation(net, a: Observation, b: Observation) -> float:
+    """Correlation of a net's own errors at two rows of its quantity: exp(-d^2 / 2 l^2), d the
+    distance of their conditions in the net's scaled inputs (module docstring)."""
+    d2 = sum(((a.conditions[c] - b.conditions[c]) * 2.0 / _input_width(net, c)) ** 2
+             for c in a.conditions if c in net.input_names)
+    return float(np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2))
 
 
 def _input_width(net, name: str) -> float:

@@ -9,8 +9,9 @@
   (2 % on friction coefficients, 1 % on bulk density, 0.5 deg on the angle of repose, 2 % on flow
   rates and discharge times); each row's uncertainty states the noise and the scatter combined.
 
-`surrogate_set` takes the model values from the nets (cheap: hundreds of sets, for the
-false-alarm rate), `dem_set` from real rig runs at the campaign preset (a few sets, to check).
+`surrogate_set` takes the model values from the nets plus a draw of the nets' own error (what
+separates the rigs' mean response from a surrogate; cheap: hundreds of sets, for the false-alarm
+rate), `dem_set` from real rig runs at the campaign preset (a few sets, to check).
 """
 from __future__ import annotations
 
@@ -134,12 +135,44 @@ def surrogate_values(nets: dict, candidates: list[Candidate], truth: Truth, obs:
 
 
 def surrogate_set(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
-                  obs: list[Observation]) -> list[Observation]:
-    """Pseudo-measurements from the nets: f(truth) + one run's seed scatter + lab noise."""
+                  obs: list[Observation], net_error: bool = True) -> list[Observation]:
+    """Pseudo-measurements from the nets: f(truth) + the nets' own error (net_error_draw: how far
+    the rigs' mean response is from the surrogate, so that a surrogate set is as far from the
+    nets as a DEM-made one; False: the nets taken as exact) + one run's seed scatter + lab noise."""
+    return surrogate_set_and_means(nets, candidates, truth, rng, obs, net_error)[0]
+
+
+def surrogate_set_and_means(nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
+                            obs: list[Observation], net_error: bool = True) -> tuple[list[Observation], dict[int, float]]:
+    """surrogate_set, and the emulated rigs' mean response at the truth for every observation
+    (f(truth) + the nets' error draw: the values free of seed scatter and lab noise)."""
     values = surrogate_values(nets, candidates, truth, obs)
     xs = row_inputs(nets, candidates, truth, obs)
-    draw = seed_scatter_draw(nets, obs, rng, xs)
-    return with_lab_noise(obs, {i: values[i] + d for i, d in enumerate(draw)}, nets, rng, xs)
+    scatter = seed_scatter_draw(nets, obs, rng, xs)
+    if net_error:
+        values = {i: v + d for (i, v), d in zip(values.items(), net_error_draw(nets, obs, rng, xs))}
+    return with_lab_noise(obs, {i: values[i] + d for i, d in enumerate(scatter)}, nets, rng, xs), values
+
+
+def net_error_draw(nets: dict, obs: list[Observation], rng: np.random.Generator, truth_inputs: list) -> np.ndarray:
+    """One draw of the nets' own error over a programme: per quantity, Gaussian with the net
+    error of the error model at the truth's inputs (errors_at) and the likelihood's correlation
+    over the conditions (fit.condition_correlation), so the likelihood's noise model is the one
+    that made the set. The rows' stated uncertainty does not include it (a lab does not know
+    our nets); the diagnosis adds it to every row, as it does for measured data."""
+    from .fit import condition_correlation
+    out = np.zeros(len(obs))
+    by: dict = {}
+    for i, o in enumerate(obs):
+        by.setdefault(o.quantity, []).append(i)
+    for q, rows in by.items():
+        net = nets[q]
+        e = np.array([float(net.errors_at(truth_inputs[i])[1][0]) if hasattr(net, "errors_at")
+                      else float(getattr(net, "net_error", 0.0)) for i in rows])
+        c = np.array([[condition_correlation(net, obs[i], obs[j]) for j in rows] for i in rows])
+        k = e[:, None] * e[None, :] * c + 1e-12 * np.diag(e * e + 1e-30)
+        out[rows] = np.linalg.cholesky(k) @ rng.normal(size=len(rows))
+    return out
 
 
 def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generator,
@@ -270,9 +303,10 @@ def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]
 
 
 def model_error(model, fit, clean: dict[int, float]) -> float | None:
-    """RMSE of the fitted model's relative errors against the set's noise-free values (the truth's
-    net values, no seed scatter, no lab noise): what the model gets wrong about the material, which
-    a measured set's residuals show only mixed with the noise (None without a fit)."""
+    """RMSE of the fitted model's relative errors against the set's noise-free values (the
+    emulated rigs' mean response at the truth: no seed scatter, no lab noise): what the model gets
+    wrong about the material, which a measured set's residuals show only mixed with the noise
+    (None without a fit)."""
     if fit is None or len(model.y) != len(clean):
         return None
     v = np.array([clean[i] for i in range(len(clean))])
@@ -342,7 +376,7 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                 obs = dem_set(setup.stores, setup.nets, setup.candidates, truth, rng, base_obs,
                               seed=int(rng.integers(1 << 30)), threads=threads, say=say)
             else:
-                obs = surrogate_set(setup.nets, setup.candidates, truth, rng, base_obs)
+                obs, means = surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs)
             if kind == "unexplained":
                 obs = density_mismatch(obs, 1.25)
             visible = signal(setup, truth, obs) if source == "surrogate" else None
@@ -350,9 +384,8 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
             s_before, s_after = d.summary_of(d.base, d.base_model), d.summary_of(d.after, d.after_model)
             truth_error = {"before": None, "after": None}
             if source == "surrogate" and kind != "unexplained":
-                clean = surrogate_values(setup.nets, setup.candidates, truth, obs)
-                truth_error = {"before": model_error(d.base_model, d.base, clean),
-                               "after": model_error(d.after_model, d.after, clean)}
+                truth_error = {"before": model_error(d.base_model, d.base, means),
+                               "after": model_error(d.after_model, d.after, means)}
             row = {"kind": kind, "set": k, "source": source, "truth": truth.theta, "effect_truth": truth.effect,
                    "strength": truth.strength, "signal": visible, "verdict": d.verdict, "effect": d.effect,
                    "best_candidate": d.candidates[0].effect if d.candidates else None,

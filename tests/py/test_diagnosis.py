@@ -248,7 +248,7 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     rows = synthetic.validate(setup, {"null": 3, "unexplained": 1}, seed=11, say=lambda *a: None)
     rng = np.random.default_rng(12)
     truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, "cohesion_sjkr", min_fraction=0.8)
-    obs = synthetic.surrogate_set(setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets))
+    obs, means = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets))
     d = dg.diagnose("strong cohesion", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
     assert d.effect == "cohesion_sjkr", (d.verdict, [(c.effect, c.statistic) for c in d.candidates])
     # the set's signal (base model's chi^2 on its noise-free values) is far above the test's
@@ -262,8 +262,7 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     # against the noise-free values, adding the named effect cuts the model's error (0.117 -> 0.064
     # here: with the tiny stores' poor nets the refit still follows a good part of the noise, so
     # only a clear fall is asserted); a null set has no "after" model
-    clean = synthetic.surrogate_values(setup.nets, setup.candidates, truth, obs)
-    before, after = synthetic.model_error(d.base_model, d.base, clean), synthetic.model_error(d.after_model, d.after, clean)
+    before, after = synthetic.model_error(d.base_model, d.base, means), synthetic.model_error(d.after_model, d.after, means)
     assert after < 0.75 * before, (before, after)
     assert all(r["truth_error_after"] is None and r["truth_error_before"] > 0 for r in rows if r["kind"] == "null")
     assert all(r["verdict"] == "no_effect_needed" for r in rows if r["kind"] == "null"), rows
@@ -274,6 +273,29 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     dem = synthetic.validate(setup, {"null": 1}, seed=13, source="dem", say=lambda *a: None)
     assert dem[0]["verdict"] in ("no_effect_needed", "effect", "indistinguishable", "unexplained")
     assert dem[0]["chi2_before"] > 0
+
+
+def test_net_error_draws_have_the_likelihoods_covariance():
+    """synthetic.net_error_draw over the validation programme: 4,000 draws at one truth have,
+    within one quantity's rows, the covariance the likelihood assumes for the nets' own error
+    (e_i e_j exp(-d^2/2l^2), the net-error part of fit.Model's covariance): every entry within
+    0.1 of sqrt(var_i var_j) (the sampling error of a covariance from 4,000 draws is ~0.02 of
+    it), and rows of different quantities uncorrelated."""
+    from pydem.calibration import synthetic
+    from pydem.calibration.fit import condition_correlation
+    from pydem.calibration.setup import TINY_STORES, load_setup
+    setup = load_setup([ROOT / s for s in TINY_STORES], say=lambda *a: None)
+    obs = synthetic.programme(setup.nets)
+    truth = synthetic.draw_truth(np.random.default_rng(3), setup.ranges, setup.candidates, None)
+    xs = synthetic.row_inputs(setup.nets, setup.candidates, truth, obs)
+    rng = np.random.default_rng(4)
+    draws = np.array([synthetic.net_error_draw(setup.nets, obs, rng, xs) for _ in range(4000)])
+    emp = draws.T @ draws / len(draws)
+    e = np.array([setup.nets[o.quantity].errors_at(x)[1][0] for o, x in zip(obs, xs)])
+    want = np.array([[e[i] * e[j] * condition_correlation(setup.nets[a.quantity], a, b) if a.quantity == b.quantity else 0.0
+                      for j, b in enumerate(obs)] for i, a in enumerate(obs)])
+    scale = np.sqrt(np.outer(np.diag(want), np.diag(want)))
+    assert np.all(np.abs(emp - want) < 0.1 * scale + 1e-300), np.max(np.abs(emp - want) / scale)
 
 
 def test_the_error_model_finds_where_the_error_is_and_splits_it():
