@@ -34,6 +34,8 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--stores", nargs="+", help="store paths instead of diag_<rig>_<preset>.h5 (a mix of presets)")
     ap.add_argument("--label", help="results name (default: the preset)")
+    ap.add_argument("--exact-nets", action="store_true",
+                    help="surrogate sets without the nets' own error (the nets taken as the rigs' exact mean; before 2026-11-25)")
     args = ap.parse_args()
     stores = ([ROOT / s for s in args.stores] if args.stores else
               [ROOT / f"data/campaigns/diag_{r}_{args.preset}.h5" for r in ("ring_shear", "aor", "hopper")])
@@ -42,7 +44,8 @@ def main() -> int:
     kinds = {"null": args.null, **{c.name: args.sets for c in setup.candidates}, "unexplained": args.unexplained}
     t0 = time.perf_counter()
     journal = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.jsonl"  # resumable
-    rows = synthetic.validate(setup, kinds, seed=args.seed, source=args.source, threads=args.threads, journal=journal)
+    rows = synthetic.validate(setup, kinds, seed=args.seed, source=args.source, threads=args.threads, journal=journal,
+                              net_error=not args.exact_nets)
     scores = synthetic.score_sets(rows)
     out = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.json"
     out.parent.mkdir(exist_ok=True)

@@ -350,9 +350,10 @@ def score_sets(results: list[dict]) -> dict:
 
 
 def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surrogate", threads: int = 1,
-             say=print, journal=None) -> list[dict]:
+             say=print, journal=None, net_error: bool = True) -> list[dict]:
     """Runs the protocol: kinds = {"null": n, <candidate name>: n, "unexplained": n}; source
-    "surrogate" or "dem". One row per set: truth, verdict, chosen effect, errors before/after."""
+    "surrogate" or "dem" (net_error: surrogate sets carry a draw of the nets' own error, as
+    DEM-made ones do). One row per set: truth, verdict, chosen effect, errors before/after."""
     import json
     from pathlib import Path
     from .diagnose import diagnose
@@ -376,7 +377,7 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                 obs = dem_set(setup.stores, setup.nets, setup.candidates, truth, rng, base_obs,
                               seed=int(rng.integers(1 << 30)), threads=threads, say=say)
             else:
-                obs, means = surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs)
+                obs, means = surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, net_error)
             if kind == "unexplained":
                 obs = density_mismatch(obs, 1.25)
             visible = signal(setup, truth, obs) if source == "surrogate" else None
