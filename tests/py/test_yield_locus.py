@@ -63,6 +63,11 @@ def test_ring_shear_metric_functions_by_hand():
     assert m["mu_ie_s_40"].value == pytest.approx(np.mean(mus), rel=1e-14)
     assert m["mu_ie_s_40"].uncertainty == pytest.approx(np.std(mus, ddof=1) / math.sqrt(2), rel=1e-12)
     assert m["mu_ie_s_80"].value == 900 / 1600 and math.isnan(m["mu_ie_s_80"].uncertainty)
+    # a lid that carried no load is a clear error, not a division by zero
+    with pytest.raises(RuntimeError, match="lid carried no load in the steady pre-shear"):
+        preshear_metrics([(np.full(8, 10.0), np.zeros(8), np.full(8, 0.02))], {})
+    with pytest.raises(RuntimeError, match="no load at the 40% shear point"):
+        shear_point_metrics([(0.4, 0.0, 5.0)], {})
     line = [(0.25, 500.0, 100 + 0.5 * 500), (0.5, 1000.0, 100 + 0.5 * 1000), (0.75, 1500.0, 100 + 0.5 * 1500)]
     locus_metrics(2000.0, 100 + 0.5 * 2000 + 50, line, m, info)  # a pre-shear point above the locus: noted
     assert "above the yield locus" in info["yield_locus_note"] and "phi_lin" not in m
