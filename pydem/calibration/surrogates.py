@@ -221,7 +221,7 @@ def replicate_groups(store, rep, net: QuantityNet) -> tuple[np.ndarray, np.ndarr
     does, plus the shear fraction)."""
     from .pooled_runs import pooled_params
     q = net.quantity
-    params = pooled_params(store, rep) if rep.spec.names != store.spec.names else rep.params
+    params = pooled_params(store, rep)
     if q.metric == "mu_ie_s":
         cols = list(fraction_columns(rep.metric_names))
     else:
@@ -282,8 +282,10 @@ def test_correlation(store, net: QuantityNet, rep=None) -> float:
         for p in np.unique(rep.points):
             v = rep.values[(rep.points == p) & (rep.status == 1)][:, cols]
             v = v[np.all(np.isfinite(v), axis=1)]
-            sd = v.std(axis=0, ddof=1) if len(v) >= 3 else np.zeros(len(cols))
-            if len(v) >= 3 and np.all(sd > 0):
+            if len(v) < 3:
+                continue
+            sd = v.std(axis=0, ddof=1)
+            if np.all(sd > 0):
                 dev.append((v - v.mean(axis=0)) / sd)
         if len(dev) >= 5:
             c = np.corrcoef(np.vstack(dev).T)
@@ -371,14 +373,20 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
     return nets
 
 
-def replicate_shape(store, pooled, net: QuantityNet) -> tuple[float, float]:
-    """(scatter_ratio, test_correlation) of a net from the store's replicates (replicate_store_path;
-    without them: nan, and the correlation from the store's own runs)."""
+def replicate_store(store, pooled=()):
+    """The store's replicate store, opened (replicate_store_path), or None."""
     path = replicate_store_path(store, pooled)
     if path is None:
-        return float("nan"), test_correlation(store, net)
+        return None
     from ..campaign import Campaign
-    rep = Campaign.open(path).store
+    return Campaign.open(path).store
+
+
+def replicate_shape(store, rep, net: QuantityNet) -> tuple[float, float]:
+    """(scatter_ratio, test_correlation) of a net from the replicate store `rep` (without one:
+    nan, and the correlation from the store's own runs)."""
+    if rep is None:
+        return float("nan"), test_correlation(store, net)
     return fit_scatter_ratio(net, *replicate_groups(store, rep, net)), test_correlation(store, net, rep)
 
 
@@ -393,31 +401,32 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
             stamp.touch()  # recently used: the last set _prune_slots lets go
         except OSError:
             pass  # a read-only checkout
-        nets = {}
+        nets, stale = {}, []
         for f in sorted(d.glob("*.npz")):
             with np.load(f) as a:
                 n = QuantityNet.from_arrays(a)
-                meta = str(a["meta"])
-            if "scatter_ratio" not in meta:  # cached before the replicates gave the scatter's shape and correlation
-                n.scatter_ratio, n.test_correlation = replicate_shape(store, pooled, n)
-                try:
-                    np.savez(f, **n.to_arrays())
-                except OSError:
-                    pass  # a read-only checkout: measured again on the next load
+                if "scatter_ratio" not in str(a["meta"]):  # cached before the replicates gave the scatter's shape and correlation
+                    stale.append((f, n))
             nets[n.quantity] = n
+        rep = replicate_store(store, pooled) if stale else None
+        for f, n in stale:
+            n.scatter_ratio, n.test_correlation = replicate_shape(store, rep, n)
+            try:
+                np.savez(f, **n.to_arrays())
+            except OSError:
+                pass  # a read-only checkout: measured again on the next load
         return nets
     extra = "".join(f" + {(o.status == 1).sum()} of {o.path.name}" for o in pooled)
     say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs{extra}; cached in {d})")
     nets = train(store, say, pooled)
-    rep = replicate_store_path(store, pooled)
+    rep = replicate_store(store, pooled)
     if rep is not None:
-        from ..campaign import Campaign
-        for q, sd in seed_scatter(Campaign.open(rep).store).items():
+        for q, sd in seed_scatter(rep).items():
             if q in nets:
                 nets[q].scatter = sd
-                say(f"  {q.key:28s} seed scatter {sd:.4g} (from {rep.name})")
+                say(f"  {q.key:28s} seed scatter {sd:.4g} (from {rep.path.name})")
     for q, n in nets.items():
-        n.scatter_ratio, n.test_correlation = replicate_shape(store, pooled, n)
+        n.scatter_ratio, n.test_correlation = replicate_shape(store, rep, n)
         if np.isfinite(n.scatter_ratio):
             say(f"  {q.key:28s} seed scatter {n.scatter_ratio:.2f} of the error model's sd (the replicates vary with it)")
         if n.test_correlation:
