@@ -199,10 +199,15 @@ class Campaign:
         self.store.save()
         progress.update("error" not in out)
 
+    def default_workers(self) -> int:
+        """Runs side by side by default: one per core for the runs' thread count (on 2 cores two
+        1-thread runs beat one 2-thread run: bench/README.md, campaign throughput)."""
+        threads = int(self.store.spec.fixed.get("num_threads", 1))
+        return max(1, (os.cpu_count() or 1) // threads)
+
     def _run_local(self, workers, args, progress):
         from .workers import WorkerStartError, run_local
-        threads = int(self.store.spec.fixed.get("num_threads", 1))
-        workers = workers or max(1, (os.cpu_count() or 1) // threads)
+        workers = workers or self.default_workers()
 
         def say(msg):
             sys.stderr.write(f"\n  {msg}\n")
@@ -242,6 +247,11 @@ class Campaign:
         if done.any():
             w = s.wall[done]
             lines.append(f"  wall time per run: median {np.median(w):.1f} s, total {w.sum() / 3600:.2f} h of worker time")
+            workers = self.default_workers()
+            rate = workers * 3600.0 / float(np.mean(w))  # the mean, not the median: slow runs cost their full time
+            left = f", the {c['pending']} pending in about {c['pending'] / rate:.1f} h" if c["pending"] else ""
+            lines.append(f"  throughput: {rate:.1f} runs/h at the recorded mean run time with {workers} worker(s) of "
+                         f"{int(spec.fixed.get('num_threads', 1))} thread(s) (the default here){left}")
         lines.append("  ranges: " + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in spec.ranges.items()))
         if spec.fixed:
             lines.append("  fixed: " + ", ".join(f"{k}={v}" for k, v in spec.fixed.items()))

@@ -185,3 +185,16 @@ def test_dask_local_cluster(tmp_path):
     assert counts["done"] == 2
     s = CampaignStore.open(tmp_path / "d.h5")
     assert np.all(np.isfinite(s.values[:, s.metric_names.index("angle_of_repose")]))
+
+
+def test_status_states_throughput_and_time_left(tmp_path, monkeypatch):
+    """Runs per hour = workers x 3600 / mean wall time of the finished runs (the mean: slow runs
+    cost their whole time); the pending runs' time left follows from it."""
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)  # two 1-thread workers by default
+    c = Campaign.create(tmp_path / "t.h5", spec(samples=5))
+    c.store.record_done(0, {"angle_of_repose": (30.0, 0.5, "deg")}, 100.0)
+    c.store.record_done(1, {"angle_of_repose": (31.0, 0.5, "deg")}, 300.0)  # mean 200 s: 36 runs/h on 2 workers
+    c.store.save()
+    text = Campaign.open(tmp_path / "t.h5").status_text()
+    assert "throughput: 36.0 runs/h" in text and "2 worker(s) of 1 thread(s)" in text
+    assert "the 3 pending in about 0.1 h" in text  # 3 / 36 h
