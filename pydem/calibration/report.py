@@ -48,9 +48,13 @@ def _axis_condition(q) -> str | None:
     return {"ring-shear": "preshear_stress", "hopper": "slot_width"}.get(q.rig)
 
 
-def plot_measured_vs_model(observations, sigma, models: dict[str, np.ndarray]) -> bytes:
-    """Measured (error bars: each row's sigma) and each model's predictions ({label: values}; the
-    first dashed, the others solid) against each quantity's condition, one panel per quantity."""
+def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.ndarray]]) -> bytes:
+    """Measured (error bars: each row's stated uncertainty) and each model's predictions with a band
+    of +-1 sigma of measured - model at that model's estimate ({label: (values, sigma)}; the first
+    dashed, the others solid) against each quantity's condition, one panel per quantity. Each
+    model carries its own sigma: the seed scatter and the nets' error change with the parameters
+    (a cohesive estimate scatters more), so a band drawn from the base model's sigma would misstate
+    the fit with the effect."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -74,11 +78,18 @@ def plot_measured_vs_model(observations, sigma, models: dict[str, np.ndarray]) -
             x = x[order]
             ii = [ii[j] for j in order]
             col = f"C{k}"
-            ax.errorbar(x, [observations[i].value for i in ii], yerr=[sigma[i] for i in ii], fmt="o",
-                        color=col, capsize=3, label=f"measured {label}".strip())
-            for m, (name, pred) in enumerate(models.items()):
-                ax.plot(x, pred[ii], "--x" if m == 0 else "-+", color=col, alpha=0.8 if m == 0 else 1.0,
+            u = [observations[i].uncertainty if observations[i].uncertainty_given else 0.0 for i in ii]
+            ax.errorbar(x, [observations[i].value for i in ii], yerr=u, fmt="o", color=col, capsize=3,
+                        label=f"measured {label}".strip(), zorder=3)
+            for m, (name, (pred, sigma)) in enumerate(models.items()):
+                y, sd = pred[ii], sigma[ii]
+                xm = x if len(x) > 1 else x + 0.25 * (m + 1)  # one point: each model beside the measurement
+                ax.plot(xm, y, "--x" if m == 0 else "-+", color=col, alpha=0.8 if m == 0 else 1.0,
                         ms=6 if m == 0 else 10, label=f"{name} {label}".strip())
+                if len(x) > 1:
+                    ax.fill_between(x, y - sd, y + sd, color=col, alpha=0.08 if m == 0 else 0.18, lw=0)
+                else:  # one point: the band as an error bar
+                    ax.errorbar(xm, y, yerr=sd, fmt="none", color=col, alpha=0.5 if m == 0 else 0.9, capsize=3)
         ax.set_title(q.key, fontsize=10)
         if cname == "preshear_stress":
             ax.set_xscale("log")
@@ -87,11 +98,13 @@ def plot_measured_vs_model(observations, sigma, models: dict[str, np.ndarray]) -
             ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         elif cname is None:
             ax.set_xticks([])
+            ax.set_xlim(-0.4, 0.25 * len(models) + 0.4)
         ax.set_xlabel({"preshear_stress": "pre-shear stress (Pa)", "slot_width": "slot width (m)"}.get(cname, ""))
         ax.legend(fontsize=6)
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
-    fig.suptitle("measured (bars: 1 sigma incl. seed scatter and net error) vs model", fontsize=10)
+    fig.suptitle("measured (bars: stated uncertainty) vs model (bands: ±1 sigma of measured − model at that "
+                 "model's estimate: max(stated, seed scatter) and the nets' error)", fontsize=9)
     return _png(fig)
 
 
@@ -146,10 +159,10 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    models = {"base model": d.base_model.predict(d.base.best)}
+    models = {"base model": (d.base_model.predict(d.base.best), d.base_model.sigma)}
     if d.after is not None:
-        models[f"with {d.effect or 'best candidate'}"] = d.after_model.predict(d.after.best)
-    out = {"residuals.png": plot_measured_vs_model(d.observations, d.base_model.sigma, models)}
+        models[f"with {d.effect or 'best candidate'}"] = (d.after_model.predict(d.after.best), d.after_model.sigma)
+    out = {"residuals.png": plot_measured_vs_model(d.observations, models)}
     fig, ax = plt.subplots(figsize=(5.5, 0.5 + 0.45 * max(len(d.candidates), 1)))
     names = [c.effect for c in d.candidates][::-1]
     vals = [c.statistic for c in d.candidates][::-1]
@@ -291,8 +304,8 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
     data = c.as_dict()
     data["context"] = context or {}
     (out / "calibration.json").write_text(json.dumps(strict_json(data), indent=1, allow_nan=False))
-    plots = {"residuals.png": plot_measured_vs_model(c.observations, c.model.sigma,
-                                                      {"calibrated model": c.model.predict(c.fit.best)}),
+    plots = {"residuals.png": plot_measured_vs_model(c.observations,
+                                                      {"calibrated model": (c.model.predict(c.fit.best), c.model.sigma)}),
              "parameters.png": plot_parameters(c.fit, c.screening)}
     for name, png in plots.items():
         (out / name).write_bytes(png)
