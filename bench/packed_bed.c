@@ -5,7 +5,7 @@
  * W = 40 mm; 40 -> 99,200, W = 88 mm); random initial velocities in +-0.05 m/s; g = 9.81;
  * dt = 1e-5 s; skin 0.2 mm. Settle, then time a number of steps at each thread count.
  *
- *   packed_bed [--n-side 18] [--mu-r 0.1] [--settle 20000] [--steps 5000] [--threads 1,2] [--repeat 1]
+ *   packed_bed [--n-side 18] [--mu-r 0.1] [--cohesion 0] [--settle 20000] [--steps 5000] [--threads 1,2] [--repeat 1]
  *              [--settle-threads 2] [--csv FILE] [--demo] [--save FILE] [--load FILE]
  * Prints one line per timed run (each thread count, --repeat times over); --csv appends
  * them as CSV rows. --save writes the settled
@@ -95,7 +95,7 @@ static void die(dem_domain *d, dem_status s, const char *what)
 }
 
 /* The box: material, pair constants, five frictional plane walls (open top). */
-static dem_domain *build_domain(const dem_domain_def *def, double mu_r, dem_material *mat)
+static dem_domain *build_domain(const dem_domain_def *def, double mu_r, double cohesion, dem_material *mat)
 {
     dem_domain *d;
     char msg[256];
@@ -109,6 +109,8 @@ static dem_domain *build_domain(const dem_domain_def *def, double mu_r, dem_mate
     dem_pair_def p = dem_default_pair_def();          /* e 0.5, mu_s 0.5, EPSD2 */
     p.rolling_friction = mu_r;
     if ((s = dem_pair_set(d, *mat, *mat, &p)) != DEM_OK) die(d, s, "pair");
+    if (cohesion > 0.0 && (s = dem_pair_set_effect(d, *mat, *mat, "cohesion_sjkr", &cohesion, 1)) != DEM_OK)
+        die(d, s, "cohesion");
     const int faces[5][2] = {{0, 1}, {0, -1}, {1, 1}, {1, -1}, {2, 1}};
     for (int k = 0; k < 5; k++) {
         dem_plane_wall_def w = dem_default_plane_wall_def();
@@ -125,11 +127,12 @@ static dem_domain *build_domain(const dem_domain_def *def, double mu_r, dem_mate
 int main(int argc, char **argv)
 {
     int n_side = 18, settle = 20000, steps = 5000, settle_threads = 2, demo = 0, repeat = 1;
-    double mu_r = 0.1;
+    double mu_r = 0.1, cohesion = 0.0;
     const char *threads_arg = "1,2", *csv = NULL, *save = NULL, *load = NULL;
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--n-side") && k + 1 < argc) n_side = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--mu-r") && k + 1 < argc) mu_r = atof(argv[++k]);
+        else if (!strcmp(argv[k], "--cohesion") && k + 1 < argc) cohesion = atof(argv[++k]);
         else if (!strcmp(argv[k], "--settle") && k + 1 < argc) settle = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--steps") && k + 1 < argc) steps = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
@@ -140,7 +143,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[k], "--save") && k + 1 < argc) save = argv[++k];
         else if (!strcmp(argv[k], "--load") && k + 1 < argc) load = argv[++k];
         else {
-            fprintf(stderr, "usage: packed_bed [--n-side N] [--mu-r X] [--settle S] [--steps S] [--threads 1,2] [--repeat R] "
+            fprintf(stderr, "usage: packed_bed [--n-side N] [--mu-r X] [--cohesion J_PER_M3] [--settle S] [--steps S] [--threads 1,2] [--repeat R] "
                             "[--settle-threads T] [--csv FILE] [--demo]\n");
             return 2;
         }
@@ -157,7 +160,7 @@ int main(int argc, char **argv)
     def.num_threads = settle_threads;
     if (load) def.insert_overlap_ratio = 0.2; /* settled spheres touch: accept their overlaps */
     dem_material mat;
-    dem_domain *d = build_domain(&def, mu_r, &mat);
+    dem_domain *d = build_domain(&def, mu_r, cohesion, &mat);
     double *pos, *vel, *rad;
     dem_material *mats;
     const int64_t n = lattice(n_side, nz, mat, &pos, &vel, &rad, &mats);

@@ -285,30 +285,49 @@ DEM_INLINE void effect_apply(const dem_effect_desc *ed, const double *params, co
     if (ed->torque) ed->torque(ec, params, mr);
 }
 
-/* The pair type's effects, in the order they were switched on; returns the total normal force. */
+/* What an effect's kernels see of a contact (one builder for the scalar law and the batch loops,
+ * so both hand the kernels the same numbers): n, wrel, vt as contact_in and tangential_velocity()
+ * give them, fn the repulsive normal force, kt the Mindlin stiffness; j's radius and inverse mass
+ * 0 for a wall. */
+DEM_INLINE void effect_contact_of(dem_effect_contact *ec, const double *n, const double *wrel, const double *vt,
+                                  double overlap, double distance, double radius_i, double radius_j, double inv_mass_i,
+                                  double inv_mass_j, double r_eff, double fn, double kt)
+{
+    for (int a = 0; a < 3; a++) {
+        ec->n[a] = n[a];
+        ec->wrel[a] = wrel[a];
+        ec->vt[a] = vt[a];
+    }
+    ec->overlap = overlap;
+    ec->distance = distance;
+    ec->radius_i = radius_i;
+    ec->radius_j = radius_j;
+    ec->normal_force = fn;
+    ec->r_eff = r_eff;
+    ec->inv_inertia = 2.5 * inv_mass_i / (radius_i * radius_i)
+                      + (radius_j > 0.0 ? 2.5 * inv_mass_j / (radius_j * radius_j) : 0.0);
+    ec->tangential_stiffness = kt;
+}
+
+/* The pair type's effects on the contact ec, in the order they were switched on: their
+ * tangential forces added to ft, torques to mr; returns the total normal force. */
+DEM_INLINE double effects_add(const pair_props *pp, const dem_effect_contact *ec, double *ft, double *mr)
+{
+    double fn_total = ec->normal_force;
+    for (int k = 0; k < pp->n_effects; k++)
+        effect_apply(dem_effect_get(pp->effects[k].effect), pp->effects[k].params, ec, &fn_total, ft, mr);
+    return fn_total;
+}
+
+/* The same from the scalar law's contact_in and normal_out; returns the total normal force. */
 DEM_INLINE double effects_part(const pair_props *pp, const contact_in *c, const normal_out *no, const double *vt,
                                double *ft, double *mr)
 {
-    double fn_total = no->fn;
-    if (pp->n_effects == 0) return fn_total;
+    if (pp->n_effects == 0) return no->fn;
     dem_effect_contact ec;
-    for (int a = 0; a < 3; a++) {
-        ec.n[a] = c->n[a];
-        ec.wrel[a] = c->wrel[a];
-        ec.vt[a] = vt[a];
-    }
-    ec.overlap = c->overlap;
-    ec.distance = c->distance;
-    ec.radius_i = c->radius_i;
-    ec.radius_j = c->radius_j;
-    ec.normal_force = no->fn;
-    ec.r_eff = c->r_eff;
-    ec.inv_inertia = 2.5 * c->inv_mass_i / (c->radius_i * c->radius_i)
-                     + (c->radius_j > 0.0 ? 2.5 * c->inv_mass_j / (c->radius_j * c->radius_j) : 0.0);
-    ec.tangential_stiffness = no->kt;
-    for (int k = 0; k < pp->n_effects; k++)
-        effect_apply(dem_effect_get(pp->effects[k].effect), pp->effects[k].params, &ec, &fn_total, ft, mr);
-    return fn_total;
+    effect_contact_of(&ec, c->n, c->wrel, vt, c->overlap, c->distance, c->radius_i, c->radius_j, c->inv_mass_i,
+                      c->inv_mass_j, c->r_eff, no->fn, no->kt);
+    return effects_add(pp, &ec, ft, mr);
 }
 
 /* ---- assembly --------------------------------------------------------------------------- */

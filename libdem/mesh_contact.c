@@ -125,8 +125,7 @@ static void flush(dem_domain *d, pair_batch *b, double dt_hist)
     b->m = 0;
 }
 
-/* Particle i's contacts: found, selected, histories handed over; each goes into the batch b
- * (or, for a pair type the batch loop does not cover, through contact_law() at once). */
+/* Particle i's contacts: found, selected, histories handed over; each goes into the batch b. */
 static void particle_contacts(dem_domain *d, int64_t i, double dt_hist, pair_batch *b, int64_t *bad)
 {
     tri_list *tl = &d->tris_cur;
@@ -176,22 +175,10 @@ static void particle_contacts(dem_domain *d, int64_t i, double dt_hist, pair_bat
         }
         tl->active[k] = 1;
         if (r - tc[a].dist > d->def.max_overlap_ratio * r && i < *bad) *bad = i;
-        const pair_props *pp = &row_pairs[m->material];
-        if (dem_takes_scalar_law(pp)) {
-            contact_in c;
-            const double ci = wall_contact_in(&c, n, tc[a].dist, r, d->inv_mass[i], vi, wi, vw, om);
-            contact_out o;
-            contact_law(pp, &c, dt_hist, tl->hist + 6 * k, tl->hist + 6 * k + 3, &o);
-            for (int e = 0; e < 3; e++) {
-                tl->force[3 * k + e] = o.force[e];
-                tl->torque[3 * k + e] = -ci * o.cross[e] + o.mr[e];
-            }
-            continue;
-        }
         if (b->m == DEM_PAIR_BATCH) flush(d, b, dt_hist);
         const int e = b->m++;
         b->k[e] = k;
-        b->pp[e] = pp;
+        b->pp[e] = &row_pairs[m->material];
         b->dx[e] = n[0];
         b->dy[e] = n[1];
         b->dz[e] = n[2];

@@ -5,7 +5,6 @@
 #include "contact_law.h"
 #include <float.h>
 #include <math.h>
-#include <string.h>
 
 /* The stage loops write distinct batch slots: tell GCC so it vectorises without run-time
  * overlap checks. */
@@ -19,11 +18,6 @@
  * or the batch mixes models (per contact, not vectorised: several materials with different
  * rolling models in one batch). */
 enum { ROLL_NONE = -1, ROLL_MIXED = 3 };
-
-int dem_takes_scalar_law(const pair_props *pp)
-{
-    return pp->n_effects > 0;
-}
 
 /* The rolling case of a batch of per-contact constants, from the models of the contacts that roll
  * (ROLL_NONE when none does, ROLL_MIXED when they differ): EPSD2 keeps its vectorised loop, a
@@ -43,10 +37,8 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         for (int q = 1; q < m; q++) same &= b->pp[q] == b->pp[0];
         b->uniform = m > 0 && same ? b->pp[0] : NULL;
     }
-    if (b->uniform) { /* the flags are read only where any_scalar is set */
-        const uint8_t sc = (uint8_t)dem_takes_scalar_law(b->uniform);
-        if (sc) memset(b->scalar, 1, (size_t)m);
-        b->any_scalar = sc;
+    if (b->uniform) {
+        b->has_effects = b->uniform->n_effects > 0;
         b->rolling_case = b->uniform->def.rolling_friction > 0.0 ? (int)b->uniform->def.rolling_model : ROLL_NONE;
         return;
     }
@@ -61,12 +53,11 @@ void dem_pair_batch_props(pair_batch *b, const pair_props *all)
         b->rolling[q] = pp->def.rolling_friction;
         b->rolling_damping[q] = pp->def.rolling_damping;
         b->model[q] = (int8_t)pp->def.rolling_model;
-        b->scalar[q] = (uint8_t)dem_takes_scalar_law(pp);
-        any |= b->scalar[q];
+        any |= pp->n_effects > 0;
         if (pp->def.rolling_friction > 0.0) /* the models of the contacts that roll */
             model = model == ROLL_NONE || model == (int)pp->def.rolling_model ? (int)pp->def.rolling_model : ROLL_MIXED;
     }
-    b->any_scalar = any;
+    b->has_effects = any;
     b->rolling_case = rolling_case_of(model);
 }
 
@@ -79,9 +70,10 @@ DEM_INLINE law_constants constants_at(const pair_batch *b, int q)
 }
 
 /* The loop, specialised (after inlining) for the batch's kind (pair or wall contacts), for a
- * uniform batch, whose constants are `u`, or per-contact constants, and for the rolling case
+ * uniform batch, whose constants are `u`, or per-contact constants, for the rolling case
  * `model` (ROLL_NONE drops the rolling stage: 4 of the 15 square roots and divisions per
- * contact). Every stage calls the pieces of contact_law.h.
+ * contact) and for whether any contact has effects. Every stage calls the pieces of
+ * contact_law.h.
  *
  * Why four loops and not one: a contact's law is one chain of dependent square roots and
  * divisions, longer than the processor's reorder window holds, so in a single loop the next
@@ -91,7 +83,7 @@ DEM_INLINE law_constants constants_at(const pair_batch *b, int q)
  * instructions per cycle, -12 % cycles); the operations and their order per contact are
  * unchanged, so the results are too. */
 DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uniform, const int model,
-                         const law_constants u)
+                         const law_constants u, const int effects)
 {
     const int m = b->m;
     pair_batch_scratch *s = &b->s;
@@ -123,6 +115,7 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
         s->kt[q] = no.kt;
         s->gt[q] = no.gt;
         s->fn[q] = no.fn;
+        if (effects) s->distance[q] = c.distance;
         b->overlap[q] = c.overlap;
     }
     /* stage 2: tangential spring and Coulomb cap (the force goes to b->force for now) */
@@ -162,13 +155,36 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
             }
         }
     }
+    /* stage 3b: the effects (effects.c), after the rolling part as in contact_law(): their
+     * kernels sit behind function pointers, so this loop is not vectorised, but only they run
+     * per contact — not the whole scalar law. The total normal force replaces s->fn (the
+     * friction and rolling caps above took the repulsive part); torques go to b->ti. */
+    if (effects) {
+        for (int q = 0; q < m; q++) {
+            const pair_props *pp = uniform ? b->uniform : b->pp[q];
+            double mr[3] = {0.0, 0.0, 0.0};
+            if (model != ROLL_NONE)
+                for (int a = 0; a < 3; a++) mr[a] = b->ti[a][q];
+            if (pp->n_effects > 0) {
+                const double n[3] = {s->n[0][q], s->n[1][q], s->n[2][q]}, vt[3] = {s->vt[0][q], s->vt[1][q], s->vt[2][q]};
+                const double wrel[3] = {b->wi[0][q] - b->wj[0][q], b->wi[1][q] - b->wj[1][q], b->wi[2][q] - b->wj[2][q]};
+                double ft[3] = {b->force[0][q], b->force[1][q], b->force[2][q]};
+                dem_effect_contact ec;
+                effect_contact_of(&ec, n, wrel, vt, b->overlap[q], s->distance[q], b->ri[q], wall ? 0.0 : b->rj[q],
+                                  b->imi[q], wall ? 0.0 : b->imj[q], s->r_eff[q], s->fn[q], s->kt[q]);
+                s->fn[q] = effects_add(pp, &ec, ft, mr);
+                for (int a = 0; a < 3; a++) b->force[a][q] = ft[a];
+            }
+            for (int a = 0; a < 3; a++) b->ti[a][q] = mr[a];
+        }
+    }
     /* stage 4: force on i; torques on i and on j */
     DEM_IVDEP
     for (int q = 0; q < m; q++) {
         const double n[3] = {s->n[0][q], s->n[1][q], s->n[2][q]}, fn = s->fn[q];
         const double ft[3] = {b->force[0][q], b->force[1][q], b->force[2][q]};
         double mr[3] = {0.0, 0.0, 0.0}, cross[3], ti[3], tj[3], f[3];
-        if (model != ROLL_NONE)
+        if (model != ROLL_NONE || effects)
             for (int a = 0; a < 3; a++) mr[a] = b->ti[a][q];
         tangential_cross(n, ft, cross);
         torques_from(cross, mr, s->ci[q], s->cj[q], ti, tj);
@@ -181,25 +197,31 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
     }
 }
 
-/* The loop specialised for the batch's kind, constants and rolling case. */
-DEM_INLINE void law_kind(pair_batch *b, double dt, const int wall)
+/* The loop specialised for the batch's kind, constants, rolling case and effects. */
+DEM_INLINE void law_case(pair_batch *b, double dt, const int wall, const int effects)
 {
     static const law_constants none = {0, 0, 0, 0, 0, 0, 0, 0};
     if (b->uniform) {
         const law_constants u = law_constants_of(b->uniform);
         switch (b->rolling_case) {
-        case ROLL_NONE: law_loop(b, dt, wall, 1, ROLL_NONE, u); break;
-        case DEM_ROLLING_CDT: law_loop(b, dt, wall, 1, DEM_ROLLING_CDT, u); break;
-        case DEM_ROLLING_EPSD: law_loop(b, dt, wall, 1, DEM_ROLLING_EPSD, u); break;
-        default: law_loop(b, dt, wall, 1, DEM_ROLLING_EPSD2, u); break;
+        case ROLL_NONE: law_loop(b, dt, wall, 1, ROLL_NONE, u, effects); break;
+        case DEM_ROLLING_CDT: law_loop(b, dt, wall, 1, DEM_ROLLING_CDT, u, effects); break;
+        case DEM_ROLLING_EPSD: law_loop(b, dt, wall, 1, DEM_ROLLING_EPSD, u, effects); break;
+        default: law_loop(b, dt, wall, 1, DEM_ROLLING_EPSD2, u, effects); break;
         }
         return;
     }
     switch (b->rolling_case) {
-    case ROLL_NONE: law_loop(b, dt, wall, 0, ROLL_NONE, none); break;
-    case DEM_ROLLING_EPSD2: law_loop(b, dt, wall, 0, DEM_ROLLING_EPSD2, none); break;
-    default: law_loop(b, dt, wall, 0, ROLL_MIXED, none); break;
+    case ROLL_NONE: law_loop(b, dt, wall, 0, ROLL_NONE, none, effects); break;
+    case DEM_ROLLING_EPSD2: law_loop(b, dt, wall, 0, DEM_ROLLING_EPSD2, none, effects); break;
+    default: law_loop(b, dt, wall, 0, ROLL_MIXED, none, effects); break;
     }
+}
+
+DEM_INLINE void law_kind(pair_batch *b, double dt, const int wall)
+{
+    if (b->has_effects) law_case(b, dt, wall, 1);
+    else law_case(b, dt, wall, 0);
 }
 
 void dem_pair_batch_law(pair_batch *b, double dt)
@@ -217,26 +239,4 @@ void dem_pair_batch_contact_in(const pair_batch *b, int q, contact_in *in)
     const double dv[3] = {b->dv[0][q], b->dv[1][q], b->dv[2][q]};
     const double wi[3] = {b->wi[0][q], b->wi[1][q], b->wi[2][q]}, wj[3] = {b->wj[0][q], b->wj[1][q], b->wj[2][q]};
     pair_geometry(in, b->dx[q], b->dy[q], b->dz[q], b->r2[q], b->ri[q], b->rj[q], b->imi[q], b->imj[q], dv, wi, wj);
-}
-
-void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist)
-{
-    for (int q = 0; q < b->m; q++) {
-        if (!b->scalar[q]) continue;
-        contact_in in;
-        double hist[6];
-        dem_pair_batch_contact_in(b, q, &in);
-        for (int a = 0; a < 6; a++) hist[a] = list_hist[6 * b->k[q] + a]; /* the batch loop moved b->h */
-        contact_out o;
-        contact_law(b->uniform ? b->uniform : b->pp[q], &in, dt, hist, hist + 3, &o);
-        for (int a = 0; a < 6; a++) b->h[a][q] = hist[a];
-        double ti[3], tj[3];
-        contact_torques(&o, in.ci, in.cj, ti, tj);
-        for (int a = 0; a < 3; a++) {
-            b->force[a][q] = o.force[a];
-            b->ti[a][q] = ti[a];
-            b->tj[a][q] = tj[a];
-        }
-        b->overlap[q] = in.overlap;
-    }
 }

@@ -7,9 +7,10 @@
  * instruction), and independent contacts fill each other's latency.
  *
  * The batch loop calls the pieces of contact_law.h that contact_law() calls, in the same
- * order, so results are bitwise those of the scalar law; it covers every rolling model.
- * Contacts with active effects (function pointers, not vectorisable) are flagged `scalar` and
- * go through contact_law() itself. */
+ * order, so results are bitwise those of the scalar law; it covers every rolling model and the
+ * effects (their kernels, behind function pointers, in a stage loop of their own; until
+ * 2026-11-27 a contact with effects went through the whole scalar law, which made a cohesive
+ * bed cost ~2.5x the instructions of a dry one). */
 #ifndef DEM_PAIR_BATCH_H
 #define DEM_PAIR_BATCH_H
 
@@ -22,6 +23,7 @@ typedef struct pair_batch_scratch {
     double n[3][DEM_PAIR_BATCH], vt[3][DEM_PAIR_BATCH]; /* unit normal, tangential velocity */
     double ci[DEM_PAIR_BATCH], cj[DEM_PAIR_BATCH], r_eff[DEM_PAIR_BATCH];
     double kn[DEM_PAIR_BATCH], kt[DEM_PAIR_BATCH], gt[DEM_PAIR_BATCH], fn[DEM_PAIR_BATCH];
+    double distance[DEM_PAIR_BATCH]; /* centre distance (pair) or to the surface (wall); effects only */
 } pair_batch_scratch;
 
 /* The arrays first, each a multiple of 64 bytes: every double array starts on a cache line
@@ -36,7 +38,6 @@ typedef struct pair_batch {
      * wj the wall's; r2, rj and imj are not read. */
     int64_t k[DEM_PAIR_BATCH];
     int32_t j[DEM_PAIR_BATCH];
-    uint8_t scalar[DEM_PAIR_BATCH];     /* 1: evaluate with contact_law() (set only where any_scalar) */
     const pair_props *pp[DEM_PAIR_BATCH]; /* unset when `uniform` came from the caller */
     double dx[DEM_PAIR_BATCH], dy[DEM_PAIR_BATCH], dz[DEM_PAIR_BATCH], r2[DEM_PAIR_BATCH], dist[DEM_PAIR_BATCH];
     double ri[DEM_PAIR_BATCH], rj[DEM_PAIR_BATCH], imi[DEM_PAIR_BATCH], imj[DEM_PAIR_BATCH];
@@ -51,30 +52,22 @@ typedef struct pair_batch {
     pair_batch_scratch s;
     const pair_props *uniform;          /* every contact of this pair type: the constants above unset */
     int m;                              /* contacts in the batch */
-    int any_scalar;
+    int has_effects;                    /* some contact's pair type has effects (set by dem_pair_batch_props) */
     int rolling_case;                   /* set by dem_pair_batch_props (pair_batch.c) */
 } pair_batch;
 
-/* After the gather: the scalar flags, and either `uniform` (one pair type, the common case:
+/* After the gather: whether any contact has effects, and either `uniform` (one pair type, the common case:
  * the law reads its constants once) or the per-contact constant arrays. `all`: the pair type
  * of every contact when the caller knows it (one particle material; pp[] is then not read
  * or set), else NULL and pp[] holds each contact's. */
 void dem_pair_batch_props(pair_batch *b, const pair_props *all);
 
-/* The contact law of every non-scalar contact of the batch (dt: spring history increment). */
+/* The contact law of every contact of the batch (dt: spring history increment). */
 void dem_pair_batch_law(pair_batch *b, double dt);
 
 /* The same for a batch of sphere–wall contacts (the fields as described above): bitwise the
- * results of wall_contact_in() and contact_law(); the torque on the sphere goes to ti. The
- * caller sends contacts that take the scalar law through contact_law() instead. */
+ * results of wall_contact_in() and contact_law(); the torque on the sphere goes to ti. */
 void dem_wall_batch_law(pair_batch *b, double dt);
-
-/* Whether contacts of this pair type need contact_law() itself (effects). */
-int dem_takes_scalar_law(const pair_props *pp);
-
-/* The contact law of the scalar-flagged contacts, through contact_law(), from the histories
- * in the pair list (list_hist: 6 per entry, not yet updated); results replace the batch's. */
-void dem_pair_batch_law_scalar(pair_batch *b, double dt, const double *list_hist);
 
 /* The scalar law's input for contact q (geometry and kinematics as the sweep defines them). */
 struct contact_in;

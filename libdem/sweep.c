@@ -321,7 +321,6 @@ static void sweep_rows(const sweep_ctx *ctx_in, int64_t r0, int64_t r1, int tid,
         const int64_t k1 = start[cap] - k > DEM_PAIR_BATCH ? k + DEM_PAIR_BATCH : start[cap];
         gather(ctx, row, k, k1, &b, row_of);
         dem_pair_batch_law(&b, dt_hist);
-        if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt_hist, ctx->hist);
         /* rows [row, fin) end in this batch; row fin (if below the cap) goes on in the next */
         int64_t fin = row;
         while (fin < cap && start[fin + 1] <= k1) fin++;

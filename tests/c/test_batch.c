@@ -4,8 +4,9 @@
  * bit-identical forces, torques, overlaps and updated histories. Tolerance zero: the batch loop is the same sequence
  * of IEEE operations, and the engine's results (and the published benchmarks) rely on it.
  * Every rolling model (CDT, EPSD with its dashpot, EPSD2), alone in a batch or mixed, must
- * match too. The wall form of the loop (mesh contacts) must match wall_contact_in() + contact_law()
- * the same way. */
+ * match too, and so must contacts with effects (cohesion, twisting resistance), alone, mixed with
+ * dry ones, with and without rolling. The wall form of the loop (mesh contacts) must match
+ * wall_contact_in() + contact_law() the same way. */
 #include "test_util.h"
 #include "contact_law.h"
 #include "pair_batch.h"
@@ -34,6 +35,28 @@ static pair_props props(double friction, double mu_r, dem_rolling_model model, d
     p.damping_factor = 0.7;
     p.st_over_sn_sqrt = sqrt(4.0 * p.g_star / e_star);
     return p;
+}
+
+/* The same with effects switched on (a zero parameter leaves that effect off). */
+static pair_props with_effects(pair_props p, double cohesion, double twisting)
+{
+    if (cohesion > 0.0) {
+        p.effects[p.n_effects].effect = dem_effect_find("cohesion_sjkr");
+        p.effects[p.n_effects++].params[0] = cohesion;
+    }
+    if (twisting > 0.0) {
+        p.effects[p.n_effects].effect = dem_effect_find("twisting_resistance");
+        p.effects[p.n_effects++].params[0] = twisting;
+    }
+    return p;
+}
+
+/* Whether any of the first m contacts (pair type q % n_types) has effects. */
+static int any_effects(const pair_props *types, int n_types, int m)
+{
+    int any = 0;
+    for (int q = 0; q < m; q++) any |= types[q % n_types].n_effects > 0;
+    return any;
 }
 
 /* One random contact into slot q of the batch (and its starting history into h0). */
@@ -84,25 +107,22 @@ static void reference(const pair_batch *b, int q, const double *h0, double dt, d
     out[15] = in.overlap;
 }
 
-static void check_batch(const pair_props *types, int n_types, int m, int *slides, int *limits)
+/* ...; *pulls counts the contacts whose net normal force attracts (cohesion at work). */
+static void check_batch(const pair_props *types, int n_types, int m, int *slides, int *limits, int *pulls)
 {
     static pair_batch b;
-    static double h0[DEM_PAIR_BATCH][6], list_hist[6 * 6 * DEM_PAIR_BATCH + 6];
+    static double h0[DEM_PAIR_BATCH][6];
     const double dt = 1e-6;
     memset(&b, 0, sizeof b);
     b.m = m;
-    for (int q = 0; q < m; q++) {
-        random_contact(&b, q, &types[q % n_types], h0[q]);
-        memcpy(list_hist + 6 * b.k[q], h0[q], sizeof h0[q]);
-    }
+    for (int q = 0; q < m; q++) random_contact(&b, q, &types[q % n_types], h0[q]);
     /* one pair type: every other batch is told so by the caller (one particle material), as
      * the sweep does; the others find it out */
     const int told = n_types == 1 && m % 2;
     dem_pair_batch_props(&b, told ? types : NULL);
     assert_true((b.uniform != NULL) == (n_types == 1 || m == 1));
-    assert_int_equal(b.any_scalar, 0); /* no effects: every rolling model stays in the batch */
+    assert_int_equal(b.has_effects, any_effects(types, n_types, m));
     dem_pair_batch_law(&b, dt);
-    if (b.any_scalar) dem_pair_batch_law_scalar(&b, dt, list_hist);
     for (int q = 0; q < m; q++) {
         double want[N_OUT], got[N_OUT], n[3];
         reference(&b, q, h0[q], dt, want, n);
@@ -122,6 +142,7 @@ static void check_batch(const pair_props *types, int n_types, int m, int *slides
         const double ft[3] = {want[0] - tn * n[0], want[1] - tn * n[1], want[2] - tn * n[2]};
         const double ftn = sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
         if (tn > 0 && fabs(ftn - types[q % n_types].def.friction * tn) <= 1e-9 * tn) (*slides)++;
+        if (tn < 0) (*pulls)++;
         /* rolling torque: the part of the torques on i and j that is not the lever arms' */
         double ci = b.ri[q] - 0.5 * want[15], cj = b.rj[q] - 0.5 * want[15], m[3];
         for (int a = 0; a < 3; a++) m[a] = (cj * want[3 + a] - ci * want[6 + a]) / (ci + cj);
@@ -136,10 +157,12 @@ static void test_batch_equals_scalar_law(void **state)
     (void)state;
     const pair_props types[4] = {props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6),
                                  props(0.0, 0.4, DEM_ROLLING_EPSD2, 1e8), props(1.0, 0.05, DEM_ROLLING_EPSD2, 5e5)};
-    int slides = 0, limits = 0;
-    for (int round = 0; round < 50; round++) check_batch(types, 4, round ? 1 + round % DEM_PAIR_BATCH : DEM_PAIR_BATCH, &slides, &limits);
-    for (int round = 0; round < 20; round++) check_batch(types, 4, DEM_PAIR_BATCH, &slides, &limits);
-    for (int round = 0; round < 40; round++) check_batch(types + round % 4, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits);
+    int slides = 0, limits = 0, pulls = 0;
+    for (int round = 0; round < 50; round++)
+        check_batch(types, 4, round ? 1 + round % DEM_PAIR_BATCH : DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 20; round++) check_batch(types, 4, DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 40; round++) check_batch(types + round % 4, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits, &pulls);
+    assert_int_equal(pulls, 0); /* no effects: the normal force never attracts */
     assert_true(slides > 50);  /* the Coulomb cap was exercised */
     assert_true(limits > 50);  /* and the rolling limit */
 }
@@ -149,15 +172,35 @@ static void test_every_rolling_model_in_the_batch(void **state)
     (void)state;
     const pair_props types[3] = {props(0.5, 0.2, DEM_ROLLING_CDT, 3e6), props(0.4, 0.1, DEM_ROLLING_EPSD, 3e6),
                                  props(0.6, 0.3, DEM_ROLLING_EPSD2, 3e6)};
-    int slides = 0, limits = 0;
-    for (int round = 0; round < 20; round++) check_batch(types, 3, DEM_PAIR_BATCH, &slides, &limits);
-    for (int round = 0; round < 20; round++) check_batch(types + round % 2, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits);
+    int slides = 0, limits = 0, pulls = 0;
+    for (int round = 0; round < 20; round++) check_batch(types, 3, DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 20; round++) check_batch(types + round % 2, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits, &pulls);
+    assert_true(slides > 20 && limits > 20);
+}
+
+/* Effects in the batch: SJKR cohesion (a normal force) and twisting resistance (a torque), each
+ * alone and together, with every rolling case (none, EPSD2, CDT, EPSD), alone in a batch (the
+ * uniform loop) and mixed with dry pair types. */
+static void test_effects_in_the_batch(void **state)
+{
+    (void)state;
+    const pair_props types[6] = {with_effects(props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), 5e4, 0.0),
+                                 with_effects(props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6), 1e5, 0.3),
+                                 props(0.4, 0.1, DEM_ROLLING_EPSD2, 3e6),
+                                 with_effects(props(0.6, 0.2, DEM_ROLLING_CDT, 3e6), 0.0, 0.5),
+                                 with_effects(props(0.5, 0.1, DEM_ROLLING_EPSD, 3e6), 2e4, 0.2),
+                                 with_effects(props(0.7, 0.0, DEM_ROLLING_EPSD2, 1e8), 0.0, 0.4)};
+    int slides = 0, limits = 0, pulls = 0;
+    for (int round = 0; round < 30; round++) check_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 30; round++) check_batch(types, 6, DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 60; round++) check_batch(types + round % 6, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits, &pulls);
+    assert_true(pulls > 50);  /* cohesion outweighed the elastic force in some contacts */
     assert_true(slides > 20 && limits > 20);
 }
 
 /* Wall contacts: a sphere against a moving, turning surface, as dem_mesh_contacts_rows batches
  * them, against the scalar law it replaced. */
-static void check_wall_batch(const pair_props *types, int n_types, int m, int *slides)
+static void check_wall_batch(const pair_props *types, int n_types, int m, int *slides, int *pulls)
 {
     static pair_batch b;
     static double h0[DEM_PAIR_BATCH][6], v[DEM_PAIR_BATCH][3], vw[DEM_PAIR_BATCH][3];
@@ -179,7 +222,7 @@ static void check_wall_batch(const pair_props *types, int n_types, int m, int *s
         }
     }
     dem_pair_batch_props(&b, NULL);
-    assert_int_equal(b.any_scalar, 0);
+    assert_int_equal(b.has_effects, any_effects(types, n_types, m));
     dem_wall_batch_law(&b, dt);
     for (int q = 0; q < m; q++) {
         const double n[3] = {b.dx[q], b.dy[q], b.dz[q]}, w[3] = {b.wi[0][q], b.wi[1][q], b.wi[2][q]},
@@ -207,6 +250,7 @@ static void check_wall_batch(const pair_props *types, int n_types, int m, int *s
         const double ft[3] = {want[0] - fn * n[0], want[1] - fn * n[1], want[2] - fn * n[2]};
         if (fn > 0 && fabs(sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]) - types[q % n_types].def.friction * fn) <= 1e-9 * fn)
             (*slides)++;
+        if (fn < 0) (*pulls)++;
     }
 }
 
@@ -216,11 +260,20 @@ static void test_wall_batch_equals_scalar_law(void **state)
     const pair_props types[5] = {props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6),
                                  props(0.8, 0.05, DEM_ROLLING_EPSD2, 1e8), props(0.4, 0.2, DEM_ROLLING_CDT, 3e6),
                                  props(0.6, 0.1, DEM_ROLLING_EPSD, 3e6)};
-    int slides = 0;
-    for (int round = 0; round < 30; round++) check_wall_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides);
-    for (int round = 0; round < 30; round++) check_wall_batch(types + round % 5, 1, DEM_PAIR_BATCH, &slides);
-    for (int round = 0; round < 10; round++) check_wall_batch(types, 5, DEM_PAIR_BATCH, &slides); /* models mixed */
+    int slides = 0, pulls = 0;
+    for (int round = 0; round < 30; round++) check_wall_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides, &pulls);
+    for (int round = 0; round < 30; round++) check_wall_batch(types + round % 5, 1, DEM_PAIR_BATCH, &slides, &pulls);
+    for (int round = 0; round < 10; round++) check_wall_batch(types, 5, DEM_PAIR_BATCH, &slides, &pulls); /* models mixed */
     assert_true(slides > 50);
+    assert_int_equal(pulls, 0);
+    /* with effects: cohesion and twisting against the wall, alone and mixed with dry types */
+    const pair_props fx[4] = {with_effects(props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), 5e4, 0.0),
+                              with_effects(props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6), 1e5, 0.3), props(0.4, 0.1, DEM_ROLLING_CDT, 3e6),
+                              with_effects(props(0.6, 0.2, DEM_ROLLING_EPSD, 3e6), 0.0, 0.5)};
+    slides = 0;
+    for (int round = 0; round < 30; round++) check_wall_batch(fx, 4, 1 + round % DEM_PAIR_BATCH, &slides, &pulls);
+    for (int round = 0; round < 40; round++) check_wall_batch(fx + round % 4, 1, DEM_PAIR_BATCH, &slides, &pulls);
+    assert_true(pulls > 50 && slides > 20);
 }
 
 int main(void)
@@ -228,6 +281,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_batch_equals_scalar_law),
         cmocka_unit_test(test_every_rolling_model_in_the_batch),
+        cmocka_unit_test(test_effects_in_the_batch),
         cmocka_unit_test(test_wall_batch_equals_scalar_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
