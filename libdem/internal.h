@@ -292,6 +292,12 @@ typedef struct dem_effect_contact {
     double tangential_stiffness; /* N/m, the Mindlin k_t = 8 G* sqrt(R* overlap) */
     double vt[3];       /* m/s, tangential velocity of i relative to the partner at the contact */
 } dem_effect_contact;
+/* The same contacts as arrays, m of them (the batch loop's view; every array m long). No
+ * wrel or inv_inertia: an effect that needs them gives no batch kernel. */
+typedef struct dem_effect_batch {
+    int m;
+    const double *n[3], *overlap, *distance, *radius_i, *radius_j, *normal_force, *r_eff, *tangential_stiffness;
+} dem_effect_batch;
 typedef struct dem_effect_param {
     const char *name, *unit;
     double neutral, min, max;
@@ -307,6 +313,11 @@ typedef struct dem_effect_desc {
     void (*tangential_force)(const dem_effect_contact *c, const double *params, double force[3]);
     /* optional: adds a torque on i to torque[3] (the partner gets the opposite) */
     void (*torque)(const dem_effect_contact *c, const double *params, double torque[3]);
+    /* optional, for speed, for an effect with a normal_force kernel only: adds that kernel's
+     * value for every contact of the batch b to fn_total[q] — bitwise what normal_force gives
+     * (the same operations: write the formula once, inline, and call it from both), in a loop
+     * the compiler can vectorise. tests/c/test_effects.c compares the two for every effect. */
+    void (*normal_force_batch)(const dem_effect_batch *b, const double *params, double *fn_total);
 } dem_effect_desc;
 const dem_effect_desc *dem_effect_get(int index);
 int dem_effect_find(const char *name);

@@ -69,6 +69,19 @@ DEM_INLINE law_constants constants_at(const pair_batch *b, int q)
     return k;
 }
 
+/* The radius of a wall contact's partner, as the effect kernels see it. */
+static const double zeros[DEM_PAIR_BATCH];
+
+/* Whether every effect of the pair type is a normal force with a batch kernel (and nothing else). */
+static int batch_kernels_only(const pair_props *pp)
+{
+    for (int k = 0; k < pp->n_effects; k++) {
+        const dem_effect_desc *e = dem_effect_get(pp->effects[k].effect);
+        if (!e->normal_force_batch || e->tangential_force || e->torque) return 0;
+    }
+    return 1;
+}
+
 /* The loop, specialised (after inlining) for the batch's kind (pair or wall contacts), for a
  * uniform batch, whose constants are `u`, or per-contact constants, for the rolling case
  * `model` (ROLL_NONE drops the rolling stage: 4 of the 15 square roots and divisions per
@@ -155,11 +168,28 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
             }
         }
     }
-    /* stage 3b: the effects (effects.c), after the rolling part as in contact_law(): their
-     * kernels sit behind function pointers, so this loop is not vectorised, but only they run
-     * per contact — not the whole scalar law. The total normal force replaces s->fn (the
-     * friction and rolling caps above took the repulsive part); torques go to b->ti. */
-    if (effects) {
+    /* stage 3b: the effects (effects.c), after the rolling part as in contact_law(). The total
+     * normal force replaces s->fn (the friction and rolling caps above took the repulsive
+     * part); torques go to b->ti. Normal-force effects with batch kernels run one vectorised
+     * loop each; otherwise the kernels, behind function pointers, run per contact in a loop
+     * that is not vectorised — still only they, not the whole scalar law. */
+    if (effects && uniform && batch_kernels_only(b->uniform)) {
+        /* one pair type whose effects are normal forces with batch kernels (cohesion): each
+         * kernel over the whole batch, in the order switched on, onto s->fn in place */
+        const double *rj = wall ? zeros : b->rj;
+        const dem_effect_batch eb = {m, {s->n[0], s->n[1], s->n[2]}, b->overlap, s->distance, b->ri, rj, s->fn,
+                                     s->r_eff, s->kt};
+        double fn_total[DEM_PAIR_BATCH];
+        for (int q = 0; q < m; q++) fn_total[q] = s->fn[q];
+        for (int k = 0; k < b->uniform->n_effects; k++) {
+            const pair_effect *e = &b->uniform->effects[k];
+            dem_effect_get(e->effect)->normal_force_batch(&eb, e->params, fn_total);
+        }
+        for (int q = 0; q < m; q++) s->fn[q] = fn_total[q];
+        if (model == ROLL_NONE)
+            for (int a = 0; a < 3; a++)
+                for (int q = 0; q < m; q++) b->ti[a][q] = 0.0;
+    } else if (effects) {
         for (int q = 0; q < m; q++) {
             const pair_props *pp = uniform ? b->uniform : b->pp[q];
             double mr[3] = {0.0, 0.0, 0.0};

@@ -184,16 +184,19 @@ static void test_every_rolling_model_in_the_batch(void **state)
 static void test_effects_in_the_batch(void **state)
 {
     (void)state;
-    const pair_props types[6] = {with_effects(props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), 5e4, 0.0),
+    /* cohesion alone takes the batch kernels (a uniform batch), the others the per-contact stage */
+    const pair_props types[8] = {with_effects(props(0.5, 0.0, DEM_ROLLING_EPSD2, 3e6), 5e4, 0.0),
                                  with_effects(props(0.3, 0.1, DEM_ROLLING_EPSD2, 3e6), 1e5, 0.3),
                                  props(0.4, 0.1, DEM_ROLLING_EPSD2, 3e6),
                                  with_effects(props(0.6, 0.2, DEM_ROLLING_CDT, 3e6), 0.0, 0.5),
                                  with_effects(props(0.5, 0.1, DEM_ROLLING_EPSD, 3e6), 2e4, 0.2),
-                                 with_effects(props(0.7, 0.0, DEM_ROLLING_EPSD2, 1e8), 0.0, 0.4)};
+                                 with_effects(props(0.7, 0.0, DEM_ROLLING_EPSD2, 1e8), 0.0, 0.4),
+                                 with_effects(props(0.45, 0.15, DEM_ROLLING_EPSD2, 3e6), 8e4, 0.0),
+                                 with_effects(props(0.35, 0.2, DEM_ROLLING_CDT, 3e6), 3e4, 0.0)};
     int slides = 0, limits = 0, pulls = 0;
     for (int round = 0; round < 30; round++) check_batch(types, 3, 1 + round % DEM_PAIR_BATCH, &slides, &limits, &pulls);
-    for (int round = 0; round < 30; round++) check_batch(types, 6, DEM_PAIR_BATCH, &slides, &limits, &pulls);
-    for (int round = 0; round < 60; round++) check_batch(types + round % 6, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits, &pulls);
+    for (int round = 0; round < 30; round++) check_batch(types, 8, DEM_PAIR_BATCH, &slides, &limits, &pulls);
+    for (int round = 0; round < 80; round++) check_batch(types + round % 8, 1, DEM_PAIR_BATCH - round % 2, &slides, &limits, &pulls);
     assert_true(pulls > 50);  /* cohesion outweighed the elastic force in some contacts */
     assert_true(slides > 20 && limits > 20);
 }
@@ -272,7 +275,7 @@ static void test_wall_batch_equals_scalar_law(void **state)
                               with_effects(props(0.6, 0.2, DEM_ROLLING_EPSD, 3e6), 0.0, 0.5)};
     slides = 0;
     for (int round = 0; round < 30; round++) check_wall_batch(fx, 4, 1 + round % DEM_PAIR_BATCH, &slides, &pulls);
-    for (int round = 0; round < 40; round++) check_wall_batch(fx + round % 4, 1, DEM_PAIR_BATCH, &slides, &pulls);
+    for (int round = 0; round < 40; round++) check_wall_batch(fx + round % 4, 1, DEM_PAIR_BATCH - round % 2, &slides, &pulls);
     assert_true(pulls > 50 && slides > 20);
 }
 

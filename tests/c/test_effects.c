@@ -217,6 +217,51 @@ static void test_tangential_kernel(void **st)
     assert_true(fabs(vt[2]) <= 1e-15 && fabs(vt[0]) > 0.0); /* the kernel saw the tangential velocity */
 }
 
+/* Every effect's batch kernel (where it has one) against its scalar kernel: pair and wall
+ * contacts at random overlaps and radii, bitwise (tolerance zero: the batch loop of the contact
+ * law relies on the two giving the same IEEE result, tests/c/test_batch.c). */
+static void test_batch_kernels_match(void **st)
+{
+    (void)st;
+    uint64_t x = 0x9E3779B97F4A7C15ull;
+#define RAND01() (x ^= x << 13, x ^= x >> 7, x ^= x << 17, (double)(x >> 11) / 9007199254740992.0)
+    enum { M = 61 };
+    int checked = 0;
+    for (int e = 0; e < dem_effect_count(); e++) {
+        const dem_effect_desc *ed = dem_effect_get(e);
+        if (!ed->normal_force_batch) continue;
+        assert_non_null(ed->normal_force); /* a batch kernel is the batch form of a scalar one */
+        assert_null(ed->tangential_force);
+        assert_null(ed->torque);
+        double params[DEM_MAX_EFFECT_PARAMS];
+        for (int k = 0; k < ed->n_params; k++) params[k] = ed->params[k].neutral + 1e4 * (1.0 + RAND01());
+        for (int wall = 0; wall < 2; wall++) {
+            double n[3][M], overlap[M], dist[M], ri[M], rj[M], fn[M], r_eff[M], kt[M], total[M], want[M];
+            for (int q = 0; q < M; q++) {
+                ri[q] = 1e-3 * (0.5 + RAND01());
+                rj[q] = wall ? 0.0 : 1e-3 * (0.5 + RAND01());
+                overlap[q] = 0.05 * ri[q] * RAND01();
+                dist[q] = ri[q] + rj[q] - overlap[q];
+                n[0][q] = 1.0, n[1][q] = n[2][q] = 0.0;
+                fn[q] = RAND01();
+                r_eff[q] = wall ? ri[q] : ri[q] * rj[q] / (ri[q] + rj[q]);
+                kt[q] = 1e4 * RAND01();
+                total[q] = fn[q];
+                dem_effect_contact c = {{1.0, 0.0, 0.0}, overlap[q], dist[q], ri[q], rj[q], fn[q], r_eff[q], {0, 0, 0}, 1.0, kt[q], {0, 0, 0}};
+                want[q] = fn[q] + ed->normal_force(&c, params);
+            }
+            const dem_effect_batch b = {M, {n[0], n[1], n[2]}, overlap, dist, ri, rj, fn, r_eff, kt};
+            ed->normal_force_batch(&b, params, total);
+            for (int q = 0; q < M; q++)
+                if (memcmp(&total[q], &want[q], sizeof(double)) != 0)
+                    fail_msg("%s, %s contact %d: batch %.17g, scalar %.17g", ed->name, wall ? "wall" : "pair", q, total[q], want[q]);
+            checked++;
+        }
+    }
+#undef RAND01
+    assert_true(checked >= 2); /* cohesion_sjkr has one, pair and wall */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -225,6 +270,7 @@ int main(void)
         cmocka_unit_test(test_sjkr_wall_and_switch_off),
         cmocka_unit_test(test_twisting_spin_down),
         cmocka_unit_test(test_tangential_kernel),
+        cmocka_unit_test(test_batch_kernels_match),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
