@@ -60,3 +60,43 @@ def test_yield_locus_fit():
     assert m == pytest.approx(0.6) and c == pytest.approx(20.0) and math.isnan(m_se)
     (m, m_se), (c, c_se) = yield_locus([800, 1200, 1600], [500, 740, 980])
     assert m == pytest.approx(0.6) and c == pytest.approx(20.0) and m_se == pytest.approx(0.0, abs=1e-9)
+
+
+def _tester(monkeypatch, kick: bool):
+    """The tiny rig's filled, settled trough under its lid; kick: a sphere thrown up (0.8 m/s) at the
+    end of the settle, as a bouncy one once was. Returns the tester and the extra settling time."""
+    from pydem.rigs import ring_shear as rs
+    from pydem.rigs.common import Frames, params_from
+    extra = []
+    real = rs.settle_airborne
+
+    def settle(d, st, diameter, **kw):
+        if kick:  # the highest sphere: nothing above it
+            v = d.velocities
+            v[np.argmax(d.positions[:, 2] + d.radii)] = (0.0, 0.0, 0.8)
+            d.velocities = v
+            st.advance(0.05)  # up by ~3 cm, 10 diameters: far above the bed
+        extra.append(real(d, st, diameter, **kw))
+        return extra[-1]
+
+    monkeypatch.setattr(rs, "settle_airborne", settle)
+    c = load(RingShearConfig, "tiny")
+    t = rs.Tester(c, params_from(c.params, None), 1, Frames(None, None), None, 1.0)
+    return t, extra[0]
+
+
+def test_lid_starts_above_the_bed_not_above_a_flying_sphere(monkeypatch):
+    """A sphere in the air after the settle would set the lid's start far above the bed, beyond
+    the servo's reach in the procedure (once in 256 default runs the lid never touched the bed):
+    the rig settles on until it has landed; without one it adds no step (bitwise as before)."""
+    t, extra = _tester(monkeypatch, kick=False)
+    assert extra == 0.0
+    tops = t.d.positions[:, 2] + t.d.radii
+    clearance = t.lid_z0 - np.percentile(tops, 99)
+    t, extra = _tester(monkeypatch, kick=True)
+    assert extra > 0.0
+    tops = t.d.positions[:, 2] + t.d.radii
+    assert tops.max() <= np.percentile(tops, 99) + 5 * t.c.diameter
+    # the lid starts within the margin (5 diameters) of where it starts without the thrown sphere,
+    # which was 10 diameters up: within the servo's reach
+    assert t.lid_z0 - np.percentile(tops, 99) <= clearance + 5 * t.c.diameter
