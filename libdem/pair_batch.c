@@ -175,7 +175,9 @@ DEM_INLINE void law_loop(pair_batch *b, double dt, const int wall, const int uni
      * that is not vectorised — still only they, not the whole scalar law. */
     if (effects && uniform && batch_kernels_only(b->uniform)) {
         /* one pair type whose effects are normal forces with batch kernels (cohesion): each
-         * kernel over the whole batch, in the order switched on, onto s->fn in place */
+         * kernel over the whole batch, in the order switched on, adds to the total (each sees
+         * the repulsive force in eb.normal_force, as the scalar kernels do), which then
+         * replaces s->fn */
         const double *rj = wall ? zeros : b->rj;
         const dem_effect_batch eb = {m, {s->n[0], s->n[1], s->n[2]}, b->overlap, s->distance, b->ri, rj, s->fn,
                                      s->r_eff, s->kt};
