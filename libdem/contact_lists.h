@@ -23,6 +23,9 @@ typedef struct tri_list {
                               * evaluation to the particle's finish within one sweep */
     double *point;           /* 3 per entry: contact point, last step */
     double *normal;          /* 3 per entry: contact normal (towards the particle), last step */
+    double *gap;             /* per entry: distance from the particle to the triangle at the build,
+                              * less its radius: no contact before particle and triangle have moved
+                              * that far together (mesh_contact.c skips the entry until then) */
 } tri_list;
 
 /* Verlet neighbour list, half (each pair once), CSR by row particle i. Per entry: the

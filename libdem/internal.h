@@ -44,6 +44,8 @@ typedef struct mesh_wall {
     int64_t nv, nt, ne;
     double *x_ref, *x;       /* 3 nv */
     double *x_build;         /* 3 nv: world vertices at the last neighbour build */
+    double disp;             /* largest vertex displacement from x_build now (a rigid motion moves
+                              * no point of a triangle farther than its farthest vertex) */
     int32_t *tri;            /* 3 nt vertex indices */
     int32_t *tri_edge;       /* 3 nt edge ids: edges (v0 v1), (v1 v2), (v2 v0) */
     int32_t *edge_ntri;      /* ne: triangles sharing the edge */
@@ -265,6 +267,8 @@ int dem_particles_reserve(dem_domain *d, int64_t n, int64_t next_id);
 void dem_meshes_update_servos(dem_domain *d);
 void dem_meshes_move(dem_domain *d, double dt);
 void dem_mesh_update_world(mesh_wall *m);
+/* m->disp: its largest vertex displacement from x_build */
+void dem_mesh_measure_disp(mesh_wall *m);
 /* first of the n particles (x, r) that a mesh cuts (*which_mesh), or -1 */
 int64_t dem_meshes_cut_particles(const dem_domain *d, int64_t n, const double *x, const double *r, int *which_mesh);
 /* force the particles exert on mesh m during the last step (N) */

@@ -22,7 +22,9 @@ static int tri_list_reserve(tri_list *tl, int64_t need)
     void **u8[] = {(void **)&tl->active};
     void **h6[] = {(void **)&tl->hist};
     void **v3[] = {(void **)&tl->force, (void **)&tl->torque, (void **)&tl->point, (void **)&tl->normal};
+    void **f1[] = {(void **)&tl->gap};
     if (!dem_realloc_all(i32, 2, (size_t)c, sizeof(int32_t)) || !dem_realloc_all(u8, 1, (size_t)c, 1) ||
+        !dem_realloc_all(f1, 1, (size_t)c, sizeof(double)) ||
         !dem_realloc_all(h6, 1, (size_t)c * 6, sizeof(double)) || !dem_realloc_all(v3, 4, (size_t)c * 3, sizeof(double)))
         return 0;
     tl->capacity = c;
@@ -160,8 +162,10 @@ dem_status dem_mesh_candidates(dem_domain *d)
         dem_status s = bin_mesh(d, m, reach, m->moving ? skin : 0.0);
         if (s != DEM_OK) return s;
     }
-    for (int mi = 0; mi < d->n_meshes; mi++)
+    for (int mi = 0; mi < d->n_meshes; mi++) {
         memcpy(d->meshes[mi].x_build, d->meshes[mi].x, (size_t)d->meshes[mi].nv * 3 * sizeof(double));
+        d->meshes[mi].disp = 0.0;
+    }
 
     const int64_t old_rows = old->start ? old->n_rows : 0;
     int64_t count = 0;
@@ -179,11 +183,13 @@ dem_status dem_mesh_candidates(dem_domain *d)
                                                                * (the margin covers the round-off of hp) */
                 double q[3];
                 tri_closest_point(p, a, m->x + 3 * tv[1], m->x + 3 * tv[2], q);
-                if (tri_dist2(p, q) >= cut * cut) continue;
+                const double dist2 = tri_dist2(p, q);
+                if (dist2 >= cut * cut) continue;
                 if (!tri_list_reserve(tl, count + 1)) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
                 tl->mesh[count] = mi;
                 tl->tri[count] = t;
                 dem_tri_entry_clear(tl, count);
+                tl->gap[count] = sqrt(dist2) - d->radius[i];
                 int32_t oi = d->perm[i];
                 if (oi < old_rows)
                     for (int64_t k = old->start[oi]; k < old->start[oi + 1]; k++)

@@ -84,6 +84,7 @@ void dem_mesh_free_all(dem_domain *d)
         dem_free(tl[k]->torque);
         dem_free(tl[k]->point);
         dem_free(tl[k]->normal);
+        dem_free(tl[k]->gap);
     }
 }
 

@@ -41,9 +41,14 @@ static int find_touching(const dem_domain *d, int64_t i, touch *tc)
 {
     const tri_list *tl = &d->tris_cur;
     const double *p = d->x + 3 * i, r = d->radius[i];
+    /* the distance to a triangle shrinks at most by the particle's and the triangle's
+     * displacements since the build: an entry whose gap then exceeds both cannot touch (the
+     * margin, far above round-off, keeps the skip from deciding a case the test below would) */
+    const double moved = sqrt(tri_dist2(p, d->x_build + 3 * i)) + 1e-6 * r;
     int nt = 0;
     for (int64_t k = tl->start[i]; k < tl->start[i + 1]; k++) {
         const mesh_wall *m = &d->meshes[tl->mesh[k]];
+        if (tl->gap[k] - m->disp > moved) continue;
         const int32_t t = tl->tri[k], *tv = m->tri + 3 * t;
         const double *a = m->x + 3 * tv[0], *tn = m->normal + 3 * t;
         const double hp = tri_plane_height(p, a, tn);

@@ -72,13 +72,19 @@ void dem_meshes_move(dem_domain *d, double dt)
             m->centre[a] += m->velocity[a] * dt;
         }
         dem_mesh_update_world(m);
-        double maxd2 = 0.0;
-        for (int64_t v = 0; v < m->nv; v++) {
-            double u2 = tri_dist2(m->x + 3 * v, m->x_build + 3 * v);
-            if (u2 > maxd2) maxd2 = u2;
-        }
-        if (sqrt(maxd2) > d->mesh_disp) d->mesh_disp = sqrt(maxd2);
+        dem_mesh_measure_disp(m);
+        if (m->disp > d->mesh_disp) d->mesh_disp = m->disp;
     }
+}
+
+void dem_mesh_measure_disp(mesh_wall *m)
+{
+    double maxd2 = 0.0;
+    for (int64_t v = 0; v < m->nv; v++) {
+        double u2 = tri_dist2(m->x + 3 * v, m->x_build + 3 * v);
+        if (u2 > maxd2) maxd2 = u2;
+    }
+    m->disp = sqrt(maxd2);
 }
 
 void dem_meshes_update_servos(dem_domain *d)

@@ -437,6 +437,7 @@ out:
         if (mesh_now && mesh_now[k]) {
             dem_free(d->meshes[k].x);
             d->meshes[k].x = mesh_now[k];
+            dem_mesh_measure_disp(&d->meshes[k]); /* the build reset it at x_build */
         }
     dem_free(now);
     dem_free(mesh_now);
