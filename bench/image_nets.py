@@ -12,6 +12,7 @@ paused): other processes on the two cores take their share."""
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import statistics
 import sys
@@ -89,7 +90,7 @@ def main() -> int:
     ap.add_argument("--nets", nargs="+", default=list(networks()))
     ap.add_argument("--out", default=str(ROOT / "bench/results/image_nets.txt"))
     args = ap.parse_args()
-    lines = [f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()}, {len(__import__('os').sched_getaffinity(0))} cores, "
+    lines = [f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()}, {len(os.sched_getaffinity(0))} cores, "
              f"torch {torch.__version__}; batch {args.batch} frames (CNN-LSTM: windows of {WINDOW}), median of {args.repeats}",
              f"{'network':11s} {'size':>4s} {'thr':>3s} {'params':>11s} {'train frames/s':>14s} {'latency ms/frame':>16s} "
              f"{'batched ms/frame':>16s}"]
