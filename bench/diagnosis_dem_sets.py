@@ -95,9 +95,11 @@ def diagnose(args):
         t = row["truth"]
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,
                     "chi2_before": d.base.chi2_per_dof, "chi2_after": d.after.chi2_per_dof if d.after else None,
-                    "best": [(c.effect, round(c.statistic, 2), c.p_value) for c in d.candidates[:2]]})
+                    "best": [(c.effect, round(c.statistic, 2), c.p_value) for c in d.candidates[:2]],
+                    "outliers": [o["label"] for o in d.outliers]})
         print(f"set {k}: {row['kind']:14s} truth {t['effect']}={t['strength']}  -> {d.verdict} {d.effect or ''}  "
-              f"chi2/dof {d.base.chi2_per_dof:.2f}" + (f" -> {d.after.chi2_per_dof:.2f}" if d.after else ""), flush=True)
+              f"chi2/dof {d.base.chi2_per_dof:.2f}" + (f" -> {d.after.chi2_per_dof:.2f}" if d.after else "")
+              + "".join(f"  (outlier set aside: {o['label']})" for o in d.outliers), flush=True)
     Path(args.out or Path(args.journal).with_suffix(".diagnosed.json")).write_text(json.dumps(out, indent=1, default=float))
 
 
