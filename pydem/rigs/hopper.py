@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import geometry
 from ..domain import Domain
+from ..errors import DemRunError
 from ..walls import MeshWall
 from .checkpoint import Checkpoint, CheckpointStop, signature
 from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, size_distribution, stable_dt
@@ -76,6 +77,11 @@ class HopperConfig:
     wall_angle: float = knob(30.0, 0.0, 80.0, "deg", "wedge walls from the vertical")
     vertical_height: float = knob(0.15, 0.0, 5.0, "m", "height of the vertical section above the wedge")
     settle_time: float = knob(0.4, 0.0, 60.0, "s", "settling after the last filling batch")
+    density_boxes: str = knob("below_highest", doc="where the bulk density is measured: three boxes ending two "
+                              "diameters below the highest sphere (protocol 1, the shipped stores), or below the "
+                              "free surface's lowest point (a sloped surface leaves the former's top box part empty: "
+                              "seed scatter 43 -> 14 kg/m^3, bench/hopper_bulk_density.py)",
+                              choices=("below_highest", "below_surface"))
     max_time: float = knob(30.0, 0.1, 3600.0, "s", "discharge time limit")
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")
     max_overlap_ratio: float = knob(0.3, 0.05, 0.9, "", "overlap / smaller radius that stops the run as a blow-up "
@@ -372,6 +378,10 @@ class Hopper:
         d.dt = stable_dt(d, impact_speed=math.sqrt(2 * 9.81 * 0.2 * z_top))
 
     def _bulk_density(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
+        """(density, its block standard error) of the settled bed: solid fraction x particle density
+        in three boxes across the section (density_boxes says which)."""
+        if self.config.density_boxes == "below_surface":
+            return self._bulk_density_below_surface(d, p, h_wedge)
         c = self.config
         top = float(d.positions[:, 2].max())
         z0, z1 = max(h_wedge, 0.3 * top), top - 2 * c.largest
@@ -384,6 +394,34 @@ class Hopper:
             fr.append(s["solid_fraction"])
         fr = np.array(fr)
         return p.density * float(fr.mean()), p.density * float(fr.std(ddof=1) / math.sqrt(len(fr)))
+
+    def _bulk_density_below_surface(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
+        """Three boxes of two largest diameters each, the highest ending two diameters below the free
+        surface's lowest point (the lowest of the column tops, columns two diameters wide across the
+        section: a sloped surface or a sphere resting high on a wall moves no box into empty space);
+        a box inside the wedge is as wide as the wedge at its lower edge, less a diameter."""
+        c = self.config
+        dl = c.largest
+        x, z = d.positions[:, 0], d.positions[:, 2]
+        half_b, half_w = 0.5 * c.slot_width, 0.5 * c.top_width
+        column = np.floor((x + half_w) / (2 * dl)).astype(int)
+        tops = [z[column == k].max() for k in np.unique(column)]
+        z1 = min(tops) - 2 * dl
+        slant = 1.0 / max(math.cos(math.radians(c.wall_angle)), 1e-3)
+        fr = []
+        for k in range(3):
+            a, b = z1 - 2 * dl * (k + 1), z1 - 2 * dl * k
+            wall = half_w if a >= h_wedge else half_b + (half_w - half_b) * max(a, 0.0) / max(h_wedge, 1e-12)
+            half = wall - dl * slant
+            if a <= 0.0 or half <= dl:
+                break  # the bed is too shallow for this box: the ones above it
+            fr.append(d.region_stress("box", lo=(-half, 0.0, a), hi=(half, c.thickness, b))["solid_fraction"])
+        if not fr:
+            raise DemRunError(f"hopper: the settled bed is too shallow to measure its bulk density (free surface "
+                              f"at {min(tops):.4g} m, largest sphere {dl:.3g} m)")
+        fr = np.array(fr)
+        sem = fr.std(ddof=1) / math.sqrt(len(fr)) if len(fr) > 1 else math.nan
+        return p.density * float(fr.mean()), p.density * float(sem)
 
     def _window(self, h_wedge, z_top):
         """The whole hopper and a little below the slot, at the frame's aspect ratio."""
