@@ -16,7 +16,9 @@ from scipy import linalg, optimize
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from nn.mlp import Scaler, fold_of_rows  # noqa: E402
 from pydem.calibration.quantities import training_tables  # noqa: E402
+from pydem.calibration.surrogates import FOLDS  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, load_setup, open_store_groups  # noqa: E402
 
 
@@ -62,18 +64,15 @@ def main() -> int:
     nets = load_setup(paths, say=lambda *_: None).nets
     for rig, (store, pooled) in open_store_groups(paths).items():
         for q, (names, x, y) in training_tables(store, pooled).items():
-            xs = (x - x.min(0)) * 2 / (x.max(0) - x.min(0)) - 1
+            xs = Scaler.fit(x).forward(x)
             _, g = np.unique(x[:, :len(store.spec.names)], axis=0, return_inverse=True)
-            ids = np.unique(g)
-            order = np.random.default_rng(0).permutation(len(ids))  # the folds nn.mlp.cross_validate makes
-            fold_of = dict(zip(ids[order], np.arange(len(ids)) % 5))
-            fold = np.array([fold_of[i] for i in g])
+            fold = fold_of_rows(g, FOLDS, seed=0)  # the folds the nets' cross-validation uses
             net = nets.get(q)
             mlp = f"bagged MLP R^2 {net.r2:.3f} RMSE {net.rmse:.4g}" if net is not None else "no net"
             for log in ([False, True] if np.all(y > 0) else [False]):
                 t = np.log(y) if log else y
                 pred, t0 = np.full(len(y), np.nan), time.perf_counter()
-                for k in range(5):
+                for k in range(FOLDS):
                     te = fold == k
                     p = gp_predict(xs[~te], t[~te], xs[te])
                     pred[te] = np.exp(p) if log else p

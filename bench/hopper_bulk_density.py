@@ -36,7 +36,9 @@ def one_run(args):
     measured = cls._bulk_density
 
     def both(self, d, p, h_wedge):  # the rig's two measures on the same settled bed
-        seen["surface"] = self._bulk_density_below_surface(d, p, h_wedge)[0]
+        self.config.density_boxes = "below_surface"
+        seen["surface"] = measured(self, d, p, h_wedge)[0]
+        self.config.density_boxes = "below_highest"
         out = measured(self, d, p, h_wedge)
         seen["highest"], seen["highest_block_sd"] = out
         return out

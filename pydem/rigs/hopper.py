@@ -379,23 +379,26 @@ class Hopper:
 
     def _bulk_density(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
         """(density, its block standard error) of the settled bed: solid fraction x particle density
-        in three boxes across the section (density_boxes says which)."""
-        if self.config.density_boxes == "below_surface":
-            return self._bulk_density_below_surface(d, p, h_wedge)
+        in boxes across the section (where: density_boxes)."""
+        boxes = (self._boxes_below_surface if self.config.density_boxes == "below_surface" else
+                 self._boxes_below_highest)(d, h_wedge)
+        fr = np.array([d.region_stress("box", lo=lo, hi=hi)["solid_fraction"] for lo, hi in boxes])
+        sem = fr.std(ddof=1) / math.sqrt(len(fr)) if len(fr) > 1 else math.nan
+        return p.density * float(fr.mean()), p.density * float(sem)
+
+    def _boxes_below_highest(self, d, h_wedge: float) -> list[tuple]:
+        """Protocol 1: three boxes from the wedge's top (or 0.3 of the bed) to two diameters below the
+        highest sphere, as wide as the vertical section less a diameter."""
         c = self.config
         top = float(d.positions[:, 2].max())
         z0, z1 = max(h_wedge, 0.3 * top), top - 2 * c.largest
         if z1 - z0 < 2 * c.largest:
             z0, z1 = 0.2 * top, 0.8 * top
         half = 0.5 * (c.top_width if z0 >= h_wedge else c.slot_width) - c.largest
-        fr = []
-        for a, b in zip(np.linspace(z0, z1, 4)[:-1], np.linspace(z0, z1, 4)[1:]):
-            s = d.region_stress("box", lo=(-half, 0.0, a), hi=(half, c.thickness, b))
-            fr.append(s["solid_fraction"])
-        fr = np.array(fr)
-        return p.density * float(fr.mean()), p.density * float(fr.std(ddof=1) / math.sqrt(len(fr)))
+        edges = np.linspace(z0, z1, 4)
+        return [((-half, 0.0, a), (half, c.thickness, b)) for a, b in zip(edges[:-1], edges[1:])]
 
-    def _bulk_density_below_surface(self, d, p: Params, h_wedge: float) -> tuple[float, float]:
+    def _boxes_below_surface(self, d, h_wedge: float) -> list[tuple]:
         """Three boxes of two largest diameters each, the highest ending two diameters below the free
         surface's lowest point (the lowest of the column tops, columns two diameters wide across the
         section: a sloped surface or a sphere resting high on a wall moves no box into empty space);
@@ -405,23 +408,21 @@ class Hopper:
         x, z = d.positions[:, 0], d.positions[:, 2]
         half_b, half_w = 0.5 * c.slot_width, 0.5 * c.top_width
         column = np.floor((x + half_w) / (2 * dl)).astype(int)
-        tops = [z[column == k].max() for k in np.unique(column)]
-        z1 = min(tops) - 2 * dl
+        lowest_top = min(z[column == k].max() for k in np.unique(column))
+        z1 = lowest_top - 2 * dl
         slant = 1.0 / max(math.cos(math.radians(c.wall_angle)), 1e-3)
-        fr = []
+        boxes = []
         for k in range(3):
             a, b = z1 - 2 * dl * (k + 1), z1 - 2 * dl * k
             wall = half_w if a >= h_wedge else half_b + (half_w - half_b) * max(a, 0.0) / max(h_wedge, 1e-12)
             half = wall - dl * slant
             if a <= 0.0 or half <= dl:
                 break  # the bed is too shallow for this box: the ones above it
-            fr.append(d.region_stress("box", lo=(-half, 0.0, a), hi=(half, c.thickness, b))["solid_fraction"])
-        if not fr:
+            boxes.append(((-half, 0.0, a), (half, c.thickness, b)))
+        if not boxes:
             raise DemRunError(f"hopper: the settled bed is too shallow to measure its bulk density (free surface "
-                              f"at {min(tops):.4g} m, largest sphere {dl:.3g} m)")
-        fr = np.array(fr)
-        sem = fr.std(ddof=1) / math.sqrt(len(fr)) if len(fr) > 1 else math.nan
-        return p.density * float(fr.mean()), p.density * float(sem)
+                              f"at {lowest_top:.4g} m, largest sphere {dl:.3g} m)")
+        return boxes
 
     def _window(self, h_wedge, z_top):
         """The whole hopper and a little below the slot, at the frame's aspect ratio."""
