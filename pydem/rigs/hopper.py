@@ -78,7 +78,7 @@ class HopperConfig:
     vertical_height: float = knob(0.15, 0.0, 5.0, "m", "height of the vertical section above the wedge")
     settle_time: float = knob(0.4, 0.0, 60.0, "s", "settling after the last filling batch")
     density_boxes: str = knob("below_highest", doc="where the bulk density is measured: three boxes ending two "
-                              "diameters below the highest sphere (protocol 1, the shipped stores), or below the "
+                              "diameters below the highest sphere (protocol 1, the default), or below the "
                               "free surface's lowest point (a sloped surface leaves the former's top box part empty: "
                               "seed scatter 43 -> 14 kg/m^3, bench/hopper_bulk_density.py)",
                               choices=("below_highest", "below_surface"))

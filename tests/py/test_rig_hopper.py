@@ -136,6 +136,6 @@ def test_bulk_density_below_the_free_surface_ignores_a_slope_and_a_stray_sphere(
         assert rho == pytest.approx(1000.0 * phi, rel=0.08), (k, rho / (1000.0 * phi))
         assert np.isfinite(sem)
         old = Hopper(load(HopperConfig, "default"))
-        assert old.config.density_boxes == "below_highest"  # the default: the shipped stores' protocol 1
+        assert old.config.density_boxes == "below_highest"  # the rig's default (protocol 1); the default-preset diagnosis stores set below_surface
         rho_old, _ = old._bulk_density(bed, type("P", (), {"density": 1000.0}), h_wedge)
         assert rho_old < 0.7 * 1000.0 * phi
