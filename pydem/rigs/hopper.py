@@ -78,9 +78,9 @@ class HopperConfig:
     vertical_height: float = knob(0.15, 0.0, 5.0, "m", "height of the vertical section above the wedge")
     settle_time: float = knob(0.4, 0.0, 60.0, "s", "settling after the last filling batch")
     density_boxes: str = knob("below_highest", doc="where the bulk density is measured: three boxes ending two "
-                              "diameters below the highest sphere (protocol 1, the default), or below the "
-                              "free surface's lowest point (a sloped surface leaves the former's top box part empty: "
-                              "seed scatter 43 -> 14 kg/m^3, bench/hopper_bulk_density.py)",
+                              "diameters below the highest sphere (the tiny preset's), or below the free surface's "
+                              "lowest point (the default preset's since 2026-11-27: a sloped surface leaves the "
+                              "former's top box part empty, seed scatter 43 -> 14 kg/m^3, bench/hopper_bulk_density.py)",
                               choices=("below_highest", "below_surface"))
     max_time: float = knob(30.0, 0.1, 3600.0, "s", "discharge time limit")
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")
@@ -116,8 +116,8 @@ class HopperConfig:
         if name == "tiny":  # seconds: for tests
             return cls(particles=250, d_small=4e-3, d_large=6e-3, top_width=0.08, slot_width=0.03, thickness=0.02,
                        vertical_height=0.06, settle_time=0.15, max_time=5.0)
-        if name == "default":
-            return cls()
+        if name == "default":  # the density below the free surface (a deep bed; the tiny one is too shallow for it
+            return cls(density_boxes="below_surface")  # in the vertical section): stores record it, config_drift guards
         if name == "paper":  # a Table 1 case at full size
             return cls(case="B1-1")
         raise ValueError(f"unknown preset {name!r}: tiny, default or paper")

@@ -123,11 +123,13 @@ def test_bulk_density_below_the_free_surface_ignores_a_slope_and_a_stray_sphere(
     """A bed of known solid fraction phi = (4/3) pi r^3 / a^3 under a free surface sloping from 0.15
     to 0.19 m across the section, one sphere at 0.29 m on a wall: `below_surface` measures phi within
     8 % (three boxes of ~160 centres each; stratified counts vary by a few boundary cells, ~3 %),
-    on ten beds. The protocol-1 boxes (`below_highest`, ending below the highest sphere) reach into
-    the empty space above the slope and read more than 30 % low — the hopper's low outliers."""
+    on ten beds (the default preset's measure). The tiny preset's boxes (`below_highest`, ending
+    below the highest sphere) reach into the empty space above the slope and read more than 30 %
+    low — the hopper's low outliers before 2026-11-27."""
     surface = lambda x: 0.17 + 0.2 * x  # noqa: E731
     for k in range(10):
-        rig = Hopper(load(HopperConfig, "default", overrides=["density_boxes=below_surface"]))
+        rig = Hopper(load(HopperConfig, "default"))
+        assert rig.config.density_boxes == "below_surface"
         a, r = rig.config.largest, 0.3 * rig.config.largest
         phi = 4.0 / 3.0 * math.pi * r ** 3 / a ** 3
         bed = _StratifiedBed(rig, a, r, surface, [[0.095, 0.02, 0.29]], np.random.default_rng(k))
@@ -135,7 +137,6 @@ def test_bulk_density_below_the_free_surface_ignores_a_slope_and_a_stray_sphere(
         rho, sem = rig._bulk_density(bed, type("P", (), {"density": 1000.0}), h_wedge)
         assert rho == pytest.approx(1000.0 * phi, rel=0.08), (k, rho / (1000.0 * phi))
         assert np.isfinite(sem)
-        old = Hopper(load(HopperConfig, "default"))
-        assert old.config.density_boxes == "below_highest"  # the rig's default (protocol 1); the default-preset diagnosis stores set below_surface
+        old = Hopper(load(HopperConfig, "default", overrides=["density_boxes=below_highest"]))
         rho_old, _ = old._bulk_density(bed, type("P", (), {"density": 1000.0}), h_wedge)
         assert rho_old < 0.7 * 1000.0 * phi

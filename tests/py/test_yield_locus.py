@@ -66,6 +66,10 @@ def test_ring_shear_metric_functions_by_hand():
     # a lid that carried no load is a clear error, not a division by zero
     with pytest.raises(RuntimeError, match="lid carried no load in the steady pre-shear"):
         preshear_metrics([(np.full(8, 10.0), np.zeros(8), np.full(8, 0.02))], {})
+    # a pre-shear at 55 % of the requested stress is rejected, one at 95 % accepted
+    with pytest.raises(RuntimeError, match="misses the requested 2000 Pa"):
+        preshear_metrics([(np.full(8, 500.0), np.full(8, 1100.0), np.full(8, 0.02))], {}, target=2000.0)
+    assert preshear_metrics([(np.full(8, 500.0), np.full(8, 1900.0), np.full(8, 0.02))], {}, target=2000.0)[1] == 1900.0
     with pytest.raises(RuntimeError, match="no load at the 40% shear point"):
         shear_point_metrics([(0.4, 0.0, 5.0)], {})
     line = [(0.25, 500.0, 100 + 0.5 * 500), (0.5, 1000.0, 100 + 0.5 * 1000), (0.75, 1500.0, 100 + 0.5 * 1500)]
