@@ -283,24 +283,29 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     from pydem.calibration.setup import TINY_STORES, load_setup
     setup = load_setup([ROOT / s for s in TINY_STORES], say=lambda *a: None)
     rows = synthetic.validate(setup, {"null": 3, "unexplained": 1}, seed=11, say=lambda *a: None)
-    rng = np.random.default_rng(12)
-    truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, "cohesion_sjkr", min_fraction=0.8)
-    obs, means = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets))
-    d = dg.diagnose("strong cohesion", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
-    assert d.effect == "cohesion_sjkr", (d.verdict, [(c.effect, c.statistic) for c in d.candidates])
-    # the set's signal (base model's chi^2 on its noise-free values) is far above the test's
-    # critical value (5.4) for this strong effect (at least three times it); with the effect at its
-    # neutral value the base model reproduces the noise-free values exactly (chi^2 ~ 0, minimiser
-    # tolerance)
-    assert synthetic.signal(setup, truth, obs) > 3 * 5.41
-    neutral = synthetic.Truth(truth.theta, truth.effect, truth.parameter,
-                              next(c for c in setup.candidates if c.name == truth.effect).neutral_value(truth.theta))
-    assert synthetic.signal(setup, neutral, obs) < 0.05
-    # against the noise-free values, adding the named effect cuts the model's error (0.117 -> 0.064
-    # here: with the tiny stores' poor nets the refit still follows a good part of the noise, so
-    # only a clear fall is asserted); a null set has no "after" model
-    before, after = synthetic.model_error(d.base_model, d.base, means), synthetic.model_error(d.after_model, d.after, means)
-    assert after < 0.75 * before, (before, after)
+    ratios = []
+    for seed in range(12, 17):  # five strong-cohesion sets: the error fall is a median, one draw is noisy
+        rng = np.random.default_rng(seed)
+        truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, "cohesion_sjkr", min_fraction=0.8)
+        obs, means = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, synthetic.programme(setup.nets))
+        d = dg.diagnose("strong cohesion", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
+        assert d.effect == "cohesion_sjkr", (seed, d.verdict, [(c.effect, c.statistic) for c in d.candidates])
+        # against the noise-free values, adding the named effect cuts the model's error
+        before, after = synthetic.model_error(d.base_model, d.base, means), synthetic.model_error(d.after_model, d.after, means)
+        ratios.append(after / before)
+        if seed == 12:
+            # the set's signal (base model's chi^2 on its noise-free values) is far above the test's
+            # critical value (5.4) for this strong effect (at least three times it); with the effect
+            # at its neutral value the base model reproduces the noise-free values exactly (chi^2 ~ 0,
+            # minimiser tolerance)
+            assert synthetic.signal(setup, truth, obs) > 3 * 5.41
+            neutral = synthetic.Truth(truth.theta, truth.effect, truth.parameter,
+                                      next(c for c in setup.candidates if c.name == truth.effect).neutral_value(truth.theta))
+            assert synthetic.signal(setup, neutral, obs) < 0.05
+    # after/before 0.37-0.81 on these five (median 0.50, 2026-11-27): with the tiny stores' poor nets
+    # the refit still follows a good part of the noise, so only a clear fall of the median is asserted;
+    # a null set has no "after" model
+    assert np.median(ratios) < 0.75, ratios
     assert all(r["truth_error_after"] is None and r["truth_error_before"] > 0 for r in rows if r["kind"] == "null")
     assert all(r["verdict"] == "no_effect_needed" for r in rows if r["kind"] == "null"), rows
     # a 25 % density mismatch (no candidate) is seen as misfit; with the tiny stores wall friction
