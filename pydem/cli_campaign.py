@@ -29,6 +29,9 @@ def add_parser(sub):
     run.add_argument("--retry-failed", action="store_true", help="run the failed samples again")
     run.add_argument("--max-runs", type=int, help="stop after this many runs (the rest stay pending)")
     run.add_argument("--points", type=int, help="run only the runs of the first N design points (the rest stay pending)")
+    run.add_argument("--rerun", type=int, nargs="+", metavar="RUN",
+                     help="run only these runs (store indices) again, replacing their results: after a rig fix that "
+                          "changes what they measure")
     run.add_argument("--quiet", action="store_true")
     st = csub.add_parser("status", help="counts, timings, failures and provenance of a store")
     st.add_argument("store")
@@ -70,7 +73,7 @@ def main(args) -> int:
             if target or replicates:
                 c.grow(target, replicates)
             counts = c.run(workers=args.workers, dask=args.dask, retry_failed=args.retry_failed,
-                           max_runs=args.max_runs, quiet=args.quiet, points=args.points)
+                           max_runs=args.max_runs, quiet=args.quiet, points=args.points, rerun=args.rerun)
             print(f"campaign {args.store}: done {counts['done']}, failed {counts['failed']}, pending {counts['pending']}")
     except (SpecError, StoreError) as exc:
         print(f"pydem campaign: {exc}", file=sys.stderr)

@@ -144,11 +144,19 @@ class Campaign:
         return np.array([sample_seed(self.store.spec.seed, i) for i in range(start, start + n)])
 
     def run(self, workers: int | None = None, dask: str | None = None, retry_failed: bool = False,
-            max_runs: int | None = None, quiet: bool = False, points: int | None = None) -> dict[str, int]:
+            max_runs: int | None = None, quiet: bool = False, points: int | None = None,
+            rerun: list[int] | None = None) -> dict[str, int]:
         """Runs the pending samples (and failed ones with retry_failed); saves after each. `points`:
         only the runs of the first `points` design points (a Sobol design's first 2^k points are
-        balanced: replicate them before extending them), the rest stay pending."""
+        balanced: replicate them before extending them), the rest stay pending. `rerun`: only these
+        runs (store indices), whatever their status, their results replaced by this code's — a rig
+        fix that changes what some finished runs measure (same parameters and seeds; the session
+        records which)."""
         s = self.store
+        if rerun is not None:
+            bad = [i for i in rerun if not 0 <= i < len(s)]
+            if bad:
+                raise StoreError(f"{s.path}: no run {bad[0]} to run again (the store has runs 0-{len(s) - 1})")
         rig_cls = RIGS[s.spec.rig][0]
         made_with = s.rig_protocol
         if made_with != rig_cls.protocol:
@@ -169,15 +177,22 @@ class Campaign:
                              f"runs would mix two models in one data set. Start a new store.")
         s.lock()
         try:
-            todo = [i for i in s.pending(retry_failed) if points is None or s.points[i] < points][:max_runs]
+            if rerun is not None:
+                todo = sorted(set(int(i) for i in rerun))[:max_runs]
+            else:
+                todo = [i for i in s.pending(retry_failed) if points is None or s.points[i] < points][:max_runs]
             if not todo:
                 return s.counts()
             now = provenance()  # every session that adds runs is recorded (code version, machine)
             s.provenance.setdefault("sessions", []).append(
-                {k: now[k] for k in ("git_commit", "host", "machine", "created", "command")} | {"pending": len(todo)})
+                {k: now[k] for k in ("git_commit", "host", "machine", "created", "command")} | {"pending": len(todo)}
+                | ({"rerun": todo} if rerun is not None else {}))
             s.save()  # a grown design and this session are on disk before any run starts
             spec_json = s.spec.to_json()
-            already = int((s.status == DONE).sum() + ((s.status == FAILED).sum() if not retry_failed else 0))
+            if rerun is not None:
+                already = int(len(s) - (s.status == 0).sum()) - sum(int(s.status[i] != 0) for i in todo)
+            else:
+                already = int((s.status == DONE).sum() + ((s.status == FAILED).sum() if not retry_failed else 0))
             progress = Progress(already + len(todo), already, quiet=quiet)  # ETA of this invocation
             args = {i: (spec_json, dict(zip(s.spec.names, map(float, s.params[i]))), int(s.seeds[i])) for i in todo}
             try:

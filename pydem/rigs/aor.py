@@ -5,7 +5,9 @@ Estimator (stated with every result): in each of four azimuthal quadrants, the h
 h(r) is the highest sphere top in radial bins one diameter wide; a straight line is fitted to
 the bins whose height lies between 20 % and 80 % of the heap height (the flank, without the
 rounded top and the toe); the angle is atan(-slope). Reported: mean of the quadrants ± their
-standard error. Bulk density: solid fraction of the filled cylinder (three slabs away from the
+standard error. Where the surface of a quadrant falls from 80 % to 20 % of the heap height more
+steeply than 70 deg, the material stands (a cohesive column) and has no angle of repose: nan,
+with the reason in the note. Bulk density: solid fraction of the filled cylinder (three slabs away from the
 walls and the free surface) times the solid density, before the lift."""
 from __future__ import annotations
 
@@ -135,8 +137,14 @@ class AngleOfRepose:
         except CheckpointStop:
             return None
         angle, angle_se, n_sectors = heap_angle(d.positions, d.radii, dmean)
+        note = f"surface fit, {n_sectors} quadrants"
+        standing = standing_quadrants(d.positions, d.radii, dmean)
+        if standing:  # no slope at repose to measure; the bulk density (before the lift) stands
+            angle, angle_se = math.nan, math.nan
+            note = (f"no heap: the material stands after the lift (a face steeper than {STANDING_FACE_DEG:.0f} deg over "
+                    f"60 % of the heap height in {standing} of 4 quadrants), so there is no angle of repose")
         res = RigResult("aor")
-        res.metrics["angle_of_repose"] = Metric(angle, angle_se, "deg", f"surface fit, {n_sectors} quadrants")
+        res.metrics["angle_of_repose"] = Metric(angle, angle_se, "deg", note)
         res.metrics["bulk_density"] = Metric(*s["density"], "kg/m^3", "filled cylinder, 3 slabs")
         res.series = {k: np.asarray(v) for k, v in st.series.items()}
         res.frames = [f for f in s["frames"] if f]
@@ -187,12 +195,15 @@ class AngleOfRepose:
         return p.density * mean, p.density * se
 
 
-def heap_angle(pos: np.ndarray, radii: np.ndarray, bin_width: float) -> tuple[float, float, int]:
-    """The module's estimator; returns (mean angle deg, standard error, quadrants used)."""
+STANDING_FACE_DEG = 70.0  # a flank steeper than this is a standing face, not a slope at repose
+
+
+def quadrant_profiles(pos: np.ndarray, radii: np.ndarray, bin_width: float):
+    """The heap surface in each of four azimuthal quadrants with 10 spheres or more: (bin
+    centres, highest sphere top per radial bin; nan where a bin is empty)."""
     r = np.hypot(pos[:, 0], pos[:, 1])
     top = pos[:, 2] + radii
     sector = ((np.arctan2(pos[:, 1], pos[:, 0]) + np.pi) // (np.pi / 2)).astype(int) % 4
-    angles = []
     for s in range(4):
         m = sector == s
         if m.sum() < 10:
@@ -200,7 +211,13 @@ def heap_angle(pos: np.ndarray, radii: np.ndarray, bin_width: float) -> tuple[fl
         b = (r[m] // bin_width).astype(int)
         h = np.full(b.max() + 1, np.nan)
         np.fmax.at(h, b, top[m])
-        centres = (np.arange(len(h)) + 0.5) * bin_width
+        yield (np.arange(len(h)) + 0.5) * bin_width, h
+
+
+def heap_angle(pos: np.ndarray, radii: np.ndarray, bin_width: float) -> tuple[float, float, int]:
+    """The module's estimator; returns (mean angle deg, standard error, quadrants used)."""
+    angles = []
+    for centres, h in quadrant_profiles(pos, radii, bin_width):
         ok = ~np.isnan(h)
         hmax = np.nanmax(h)
         flank = ok & (h > 0.2 * hmax) & (h < 0.8 * hmax)
@@ -213,3 +230,18 @@ def heap_angle(pos: np.ndarray, radii: np.ndarray, bin_width: float) -> tuple[fl
     a = np.array(angles)
     se = a.std(ddof=1) / math.sqrt(len(a)) if len(a) > 1 else math.nan
     return float(a.mean()), float(se), len(a)
+
+
+def standing_quadrants(pos: np.ndarray, radii: np.ndarray, bin_width: float) -> int:
+    """Quadrants where the material stands instead of forming a slope: the surface falls from 80 %
+    to 20 % of the heap height within less than 0.6 h / tan(STANDING_FACE_DEG) of radius (the
+    farthest bins at or above each level), a face steeper than 70 deg over 60 % of the height.
+    Why: a cohesive fill can stand as the cylinder's column after the lift with a skirt of fallen
+    spheres at its foot; the flank fit then finds the skirt (8.2 deg for run 173 of the default
+    diagnosis store, cohesion 9.3e4 J/m^3). A heap at 60 deg falls over 0.35 h: not flagged."""
+    n = 0
+    for centres, h in quadrant_profiles(pos, radii, bin_width):
+        hmax = np.nanmax(h)
+        r80, r20 = (centres[np.nan_to_num(h, nan=-np.inf) >= f * hmax].max() for f in (0.8, 0.2))
+        n += (r20 - r80) < 0.6 * hmax / math.tan(math.radians(STANDING_FACE_DEG))
+    return int(n)

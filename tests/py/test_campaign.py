@@ -118,6 +118,16 @@ def test_extend_failures_lock_and_corrupt_store(tmp_path):
     s = CampaignStore.open(tmp_path / "s.h5")
     assert s.errors[1].startswith("DemRunError") and s.status[1] == FAILED and len(s) == 4
     assert np.array_equal(s.params[:2], design_points("sobol", spec().ranges, 0, 2, 3))
+    # runs measured again after a rig fix: only those, whatever their status, their results
+    # replaced (this rig is deterministic: the same values), the session noting which
+    before = s.values.copy()
+    counts = Campaign.open(tmp_path / "s.h5").run(workers=1, rerun=[1, 0], quiet=True)
+    s2 = CampaignStore.open(tmp_path / "s.h5")
+    assert counts == {"pending": 1, "done": 3, "failed": 0} and s2.status.tolist()[:3] == [DONE, DONE, DONE]
+    assert np.array_equal(s2.values[0], before[0], equal_nan=True) and s2.finished_at[0] > s.finished_at[0]
+    assert s2.status[3] == 0 and s2.provenance["sessions"][-1]["rerun"] == [0, 1]
+    with pytest.raises(StoreError, match="no run 7 to run again"):
+        Campaign.open(tmp_path / "s.h5").run(rerun=[7], quiet=True)
     other = Campaign.open(tmp_path / "s.h5")
     other.store.lock()
     with pytest.raises(StoreError, match="being written by another"):

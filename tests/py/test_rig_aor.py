@@ -27,6 +27,29 @@ def test_heap_angle_estimator_on_a_cone():
     assert angle == pytest.approx(30.0, abs=0.3)
 
 
+def test_a_standing_column_has_no_angle_and_a_steep_heap_has_one():
+    """A column of the cylinder's radius (25 mm, 36 mm high) with a skirt of fallen spheres at its
+    foot, as a cohesive fill stands after the lift: every quadrant is a standing face (the flank
+    fit alone would find the skirt's few degrees). Cones at 30 and 60 deg: none (closed form:
+    the surface falls from 80 % to 20 % over 0.6 h / tan(angle), 0.35 h at 60 deg against the
+    0.22 h of a 70 deg face)."""
+    from pydem.rigs.aor import standing_quadrants
+    rng = np.random.default_rng(1)
+    r = 0.025 * np.sqrt(rng.uniform(0, 1, 20000))
+    z = rng.uniform(0, 0.036, r.size)
+    rs = rng.uniform(0.025, 0.04, 600)  # the skirt: spheres lying on the base around the column
+    a = rng.uniform(0, 2 * np.pi, r.size + rs.size)
+    rr, zz = np.r_[r, rs], np.r_[z, rng.uniform(0, 0.004, rs.size)]
+    column = np.column_stack([rr * np.cos(a), rr * np.sin(a), zz])
+    assert standing_quadrants(column, np.full(len(rr), 1.5e-3), 3e-3) == 4
+    for angle in (30.0, 60.0):
+        r = np.sqrt(rng.uniform(0, 0.05 ** 2, 20000))
+        a = rng.uniform(0, 2 * np.pi, r.size)
+        cone = np.column_stack([r * np.cos(a), r * np.sin(a), (0.05 - r) * np.tan(np.radians(angle))])
+        assert standing_quadrants(cone, np.full(r.size, 1e-3), 2e-3) == 0, angle
+        assert heap_angle(cone, np.full(r.size, 1e-3), 2e-3)[0] == pytest.approx(angle, abs=0.5)
+
+
 @pytest.fixture(scope="module")
 def tiny_runs():
     out = {}
