@@ -1,6 +1,6 @@
 """The hopper's two bulk-density measures (`density_boxes`) on the same settled beds: boxes ending
-two diameters below the *highest* sphere (`below_highest`, the rig's default) and below the free
-surface's *lowest* point (`below_surface`, the default-preset diagnosis stores' since
+two diameters below the *highest* sphere (`below_highest`, the tiny preset's) and below the free
+surface's *lowest* point (`below_surface`, the default preset's and its diagnosis stores' since
 2026-11-27). Why: a frictional fill leaves a sloped surface (0.146 m at one wall, 0.182 m at the
 other in a DEM null set), so the first's top box is part empty and one run reads 280 kg/m^3 low
 (docs/diagnosis.md §5, "One outlying row"). Runs the replicate store's points and seeds, each run measured both ways (the

@@ -189,8 +189,8 @@ class Campaign:
                 | ({"rerun": todo} if rerun is not None else {}))
             s.save()  # a grown design and this session are on disk before any run starts
             spec_json = s.spec.to_json()
-            if rerun is not None:
-                already = int(len(s) - (s.status == 0).sum()) - sum(int(s.status[i] != 0) for i in todo)
+            if rerun is not None:  # finished runs that this invocation leaves alone
+                already = int(np.count_nonzero(s.status != 0) - np.count_nonzero(s.status[todo] != 0))
             else:
                 already = int((s.status == DONE).sum() + ((s.status == FAILED).sum() if not retry_failed else 0))
             progress = Progress(already + len(todo), already, quiet=quiet)  # ETA of this invocation

@@ -387,8 +387,9 @@ class Hopper:
         return p.density * float(fr.mean()), p.density * float(sem)
 
     def _boxes_below_highest(self, d, h_wedge: float) -> list[tuple]:
-        """Protocol 1: three boxes from the wedge's top (or 0.3 of the bed) to two diameters below the
-        highest sphere, as wide as the vertical section less a diameter."""
+        """The tiny preset's (and the default's before 2026-11-27): three boxes from the wedge's top
+        (or 0.3 of the bed) to two diameters below the highest sphere, as wide as the vertical
+        section less a diameter."""
         c = self.config
         top = float(d.positions[:, 2].max())
         z0, z1 = max(h_wedge, 0.3 * top), top - 2 * c.largest
