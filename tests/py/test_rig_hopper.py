@@ -2,13 +2,17 @@
 frames carry their labels, Table 1 cases load by name, the Beverloo fit recovers known C, k."""
 import csv
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from pydem.campaign import Campaign
+from pydem.campaign.runner import simulate
 from pydem.rigs import TABLE1, Hopper, HopperConfig, beverloo_fit, load
 from pydem.rigs.hopper import mass_flow_rate, species_counts
 
+ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
@@ -148,10 +152,7 @@ def test_the_fill_keeps_the_largest_spheres_clear_of_the_back_wall():
     (its spec, parameters and seed) failed with "particle 1015 overlaps plane wall 1" until the
     fill held such spheres clear (~12 s of one core). The clamp moves no other sphere: run 5, which
     filled before, gives bitwise its stored metrics."""
-    from pathlib import Path
-    from pydem.campaign import Campaign
-    from pydem.campaign.runner import simulate
-    st = Campaign.open(Path(__file__).resolve().parents[2] / "data/campaigns/diag_hopper_default_spread.h5").store
+    st = Campaign.open(ROOT / "data/campaigns/diag_hopper_default_spread.h5").store
     spec = st.spec.to_json()
     for i in (238, 5):
         out = simulate(spec, dict(zip(st.spec.names, map(float, st.params[i]))), int(st.seeds[i]))
