@@ -67,7 +67,8 @@ def open_store_groups(paths) -> dict:
         raise ValueError("no campaign stores given")
     groups = {}
     for rig, sts in by_rig.items():
-        main = max(sts, key=lambda st: (len(st.spec.ranges), _relative_volume(st, sts)))
+        # a store whose design holds parameters at neutral values (one-effect axes) is never the main one
+        main = max(sts, key=lambda st: (len(st.spec.ranges), not st.spec.neutral, _relative_volume(st, sts)))
         others = [st for st in sts if st is not main]
         for o in others:
             check_poolable(main, o)

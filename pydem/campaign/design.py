@@ -4,7 +4,12 @@ extendable: point i never changes when the design grows.
 - sobol: Owen-scrambled Sobol sequence (scipy), seeded; the first n points of a longer sequence
   are the n points of a shorter one, so growing a campaign keeps every finished run.
 - lhs: Latin hypercube in batches; batch k (seed + k) covers the points added by the k-th
-  growth, each batch is a Latin hypercube of its own size."""
+  growth, each batch is a Latin hypercube of its own size.
+
+A design may hold some parameters at a neutral value (`at_neutral`): then point i varies the
+others and at most one of those, the (i mod (n + 1))-th (0: none), so the points lie on the
+base model and its one-effect axes, where a diagnosis fits (each point's choice depends on i
+alone: growing keeps it)."""
 from __future__ import annotations
 
 import warnings
@@ -43,4 +48,20 @@ def design_points(kind: str, ranges: dict[str, tuple[float, float]], start: int,
             out[:, j] = np.exp(np.log(lo) + u[:, j] * (np.log(hi) - np.log(lo)))
         else:
             out[:, j] = lo + u[:, j] * (hi - lo)
+    return out
+
+
+def at_neutral(points: np.ndarray, names: list[str], neutral: dict[str, float | str], start: int) -> np.ndarray:
+    """Points start.. of a design (columns `names`) with the `neutral` parameters held at their
+    neutral values except one per point: point i leaves the k-th of them free, k = i mod (n + 1)
+    (k = 0: all held). A neutral value is a number or the name of another column it follows
+    (wall friction neutral = the particles' friction)."""
+    out = points.copy()
+    keys = list(neutral)
+    for r in range(len(out)):
+        free = (start + r) % (len(keys) + 1) - 1
+        for k, name in enumerate(keys):
+            if k != free:
+                v = neutral[name]
+                out[r, names.index(name)] = out[r, names.index(v)] if isinstance(v, str) else float(v)
     return out

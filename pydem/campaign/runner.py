@@ -13,7 +13,7 @@ import numpy as np
 
 from ..provenance import provenance
 from ..rigs import RIGS
-from .design import design_points
+from .design import at_neutral, design_points
 from .spec import CampaignSpec
 from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError, physics_of
 
@@ -126,6 +126,8 @@ class Campaign:
         if total is not None and total > n0:
             batches = s.batches + [total - n0]
             pts = design_points(spec.design, spec.ranges, n0, total, spec.seed, batches, spec.log_scale)
+            if spec.neutral:
+                pts = at_neutral(pts, spec.names, spec.neutral, n0)
             s.append(pts, self._seeds(total - n0))
             spec.samples = total
         want = max(replicates or 1, spec.replicates)

@@ -13,6 +13,8 @@ parameters under study + a seeded space-filling design. Written as TOML by users
     [ranges]                    # parameter = [low, high]
     friction = [0.05, 1.0]
     rolling_friction = [0.0, 0.6]
+    [neutral]                   # optional: held at this value (or another parameter's) but on one axis
+    wall_friction = "friction"  # (design.at_neutral: the base model and its one-effect axes)
 """
 from __future__ import annotations
 
@@ -40,6 +42,7 @@ class CampaignSpec:
     samples: int = 64
     replicates: int = 1
     log_scale: tuple[str, ...] = ()
+    neutral: dict[str, object] = field(default_factory=dict)
 
     def __post_init__(self):
         self.ranges = {k: (float(v[0]), float(v[1])) for k, v in dict(self.ranges).items()}
@@ -66,6 +69,17 @@ class CampaignSpec:
                 raise SpecError(f"ranges.{k}: log-scale sampling needs a positive low end, got {lo:g}")
             if k in self.fixed:
                 raise SpecError(f"{k}: both fixed (in [set]) and varied (in [ranges])")
+        for k, v in self.neutral.items():
+            if k not in self.ranges:
+                raise SpecError(f"neutral.{k}: not a varied parameter (add it to [ranges])")
+            lo, hi = self.ranges[k]
+            if isinstance(v, str):
+                if v not in self.ranges or v in self.neutral:
+                    raise SpecError(f"neutral.{k}: {v!r} is not a varied parameter outside [neutral]")
+                if not (lo <= self.ranges[v][0] and self.ranges[v][1] <= hi):
+                    raise SpecError(f"neutral.{k}: {v}'s range {self.ranges[v]} leaves {k}'s [{lo:g}, {hi:g}]")
+            elif isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= v <= hi:
+                raise SpecError(f"neutral.{k}: expected a number in [{lo:g}, {hi:g}] or a parameter's name, got {v!r}")
         try:  # every key must be a real knob and both ends in its allowed range
             for end in (0, 1):
                 self.config({k: v[end] for k, v in self.ranges.items()})
@@ -98,7 +112,7 @@ class CampaignSpec:
             data = tomllib.loads(Path(path).read_text())
         except (OSError, tomllib.TOMLDecodeError) as exc:
             raise SpecError(f"cannot read campaign spec {path}: {exc}") from None
-        known = {"rig", "preset", "design", "seed", "samples", "replicates", "set", "ranges", "log_scale"}
+        known = {"rig", "preset", "design", "seed", "samples", "replicates", "set", "ranges", "log_scale", "neutral"}
         unknown = set(data) - known
         if unknown:
             raise SpecError(f"{path}: unknown keys {sorted(unknown)} (known: {sorted(known)})")
@@ -111,4 +125,5 @@ class CampaignSpec:
         return cls(rig=data["rig"], preset=data.get("preset", "default"), design=data.get("design", "sobol"),
                    seed=data.get("seed", 0), samples=data.get("samples", 64),
                    replicates=data.get("replicates", 1), fixed=dict(data.get("set", {})),
-                   ranges={k: tuple(v) for k, v in ranges.items()}, log_scale=tuple(data.get("log_scale", ())))
+                   ranges={k: tuple(v) for k, v in ranges.items()}, log_scale=tuple(data.get("log_scale", ())),
+                   neutral=dict(data.get("neutral", {})))

@@ -61,6 +61,29 @@ def test_design_is_deterministic_and_extendable(kind):
     assert sorted(np.floor(first[:, 0] * 16).astype(int)) == list(range(16))
 
 
+def test_a_design_on_the_one_effect_axes_holds_the_others_neutral(tmp_path):
+    ranges = {"friction": (0.05, 1.0), "rolling_friction": (0.0, 0.5), "wall_friction": (0.05, 1.0),
+              "effects.cohesion_sjkr.cohesion_energy_density": (0.0, 1e5)}
+    neutral = {"wall_friction": "friction", "effects.cohesion_sjkr.cohesion_energy_density": 0.0}
+    c = Campaign.create(tmp_path / "axes.h5", CampaignSpec(rig="aor", preset="tiny", fixed=dict(TINY_AOR), samples=6,
+                                                            seed=3, ranges=ranges, neutral=neutral))
+    c.grow(12)  # grown: the first six points unchanged, each point's free axis set by its index alone
+    c.store.save()
+    s = CampaignStore.open(tmp_path / "axes.h5")
+    full = design_points("sobol", ranges, 0, 12, 3, [6, 6])
+    assert s.spec.neutral == neutral and np.array_equal(s.params[:, :2], full[:, :2])  # base parameters untouched
+    for i, row in enumerate(s.params):
+        free = i % 3  # 0: none, 1: wall friction, 2: cohesion
+        assert row[2] == (full[i, 2] if free == 1 else row[0])
+        assert row[3] == (full[i, 3] if free == 2 else 0.0)
+    bad = {"rolling_friction": "friction"}  # a linked range must fit: [0.05, 1] leaves [0, 0.5]
+    for neutral, words in [({"restitution": 0.5}, "neutral.restitution: not a varied parameter"),
+                           (bad, r"neutral.rolling_friction: friction's range \(0.05, 1.0\) leaves"),
+                           ({"wall_friction": 2.0}, r"neutral.wall_friction: expected a number in \[0.05, 1\]")]:
+        with pytest.raises(SpecError, match=words):
+            CampaignSpec(rig="aor", preset="tiny", ranges=ranges, neutral=neutral)
+
+
 def test_simulate_reports_failures_as_messages():
     out = simulate(spec().to_json(), {"friction": 5.0, "rolling_friction": 0.1}, seed=1)
     assert "error" in out and "friction = 5 is out of range" in out["error"]
