@@ -80,6 +80,26 @@ def rerun(args):
                                                                          for j in range(len(obs))), flush=True)
 
 
+def dem_errors(row: dict, setup, noisy: list, d) -> dict:
+    """The fitted model's relative RMSE against the rigs' own values (before lab noise) before and
+    after the chosen effect, and the floor the rigs' seed scatter puts under it (one run per test:
+    the nets' error model at the truth). error_clean_*: the scatter's share taken out in quadrature,
+    an estimate of the error against the rigs' mean response, as the surrogate sets measure it."""
+    by_label = {r["label"]: r["value"] for r in row["rows"]}
+    raw = {i: by_label[o.label] for i, o in enumerate(noisy)}
+    t = row["truth"]
+    truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
+    xs = synthetic.row_inputs(setup.nets, setup.candidates, truth, noisy)
+    floor = float(np.sqrt(np.mean([(synthetic.seed_sd_at(setup.nets[o.quantity], x) / raw[i]) ** 2
+                                   for i, (o, x) in enumerate(zip(noisy, xs))])))
+    out = {"scatter_floor": floor}
+    for when, model, fit in (("before", d.base_model, d.base), ("after", d.after_model, d.after)):
+        e = synthetic.model_error(model, fit, raw) if fit is not None else None
+        out[f"error_{when}"] = e
+        out[f"error_clean_{when}"] = None if e is None else float(np.sqrt(max(e * e - floor * floor, 0.0)))
+    return out
+
+
 def diagnose(args):
     from pydem.calibration.diagnose import diagnose as run_diagnosis
     setup = load_setup(args.stores, say=lambda *_: None)
@@ -93,14 +113,32 @@ def diagnose(args):
                                          and r["rig"] not in args.skip_rigs)
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
+        errors = dem_errors(row, setup, noisy, d)
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,
                     "chi2_before": d.base.chi2_per_dof, "chi2_after": d.after.chi2_per_dof if d.after else None,
+                    **errors,
                     "best": [(c.effect, round(c.statistic, 2), c.p_value) for c in d.candidates[:2]],
                     "outliers": [o["label"] for o in d.outliers]})
         print(f"set {k}: {row['kind']:14s} truth {t['effect']}={t['strength']}  -> {d.verdict} {d.effect or ''}  "
               f"chi2/dof {d.base.chi2_per_dof:.2f}" + (f" -> {d.after.chi2_per_dof:.2f}" if d.after else "")
-              + "".join(f"  (outlier set aside: {o['label']})" for o in d.outliers), flush=True)
+              + "".join(f"  (outlier set aside: {o['label']})" for o in d.outliers)
+              + (f"  error vs the rigs {errors['error_before']:.3f} -> {errors['error_after']:.3f} (scatter floor "
+                 f"{errors['scatter_floor']:.3f})" if errors["error_after"] is not None else ""), flush=True)
     Path(args.out or Path(args.journal).with_suffix(".diagnosed.json")).write_text(json.dumps(out, indent=1, default=float))
+    print(error_fall_text(out))
+
+
+def error_fall_text(sets: list[dict]) -> str:
+    """Median error after / before over the sets whose hidden effect was named, per effect."""
+    lines = []
+    for kind in sorted({s["kind"] for s in sets} - {"null"}):
+        hit = [s for s in sets if s["kind"] == kind and s["effect"] == kind and s.get("error_after") is not None]
+        if hit:
+            raw = np.median([s["error_after"] / s["error_before"] for s in hit])
+            clean = [s["error_clean_after"] / s["error_clean_before"] for s in hit if s["error_clean_before"] > 0]
+            lines.append(f"{kind}: {len(hit)} named; error vs the rigs after/before, median {raw:.2f}; "
+                         f"scatter taken out {np.median(clean):.2f}")
+    return "\n".join(lines)
 
 
 def main() -> int:

@@ -109,14 +109,14 @@ def with_lab_noise(obs: list[Observation], values: dict, nets: dict, rng: np.ran
     for i, o in enumerate(obs):
         v = values[i]
         n = noise_sd(o.quantity.metric, v)
-        s = _seed_sd(nets[o.quantity], None if truth_inputs is None else truth_inputs[i])
+        s = seed_sd_at(nets[o.quantity], None if truth_inputs is None else truth_inputs[i])
         # every quantity here is positive: a noise draw below zero (a nearly jammed hopper) is clipped
         value = max(float(v + rng.normal(0.0, n)), 1e-3 * abs(float(v)), 1e-9)
         out.append(Observation(o.quantity, dict(o.conditions), value, float(math.hypot(n, s)), o.label))
     return out
 
 
-def _seed_sd(net, x) -> float:
+def seed_sd_at(net, x) -> float:
     """One run's seed scatter: the net's error model at inputs x (1, inputs), or its pooled value."""
     if x is not None and hasattr(net, "errors_at"):
         return float(net.errors_at(x)[0][0])
@@ -191,7 +191,7 @@ def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generat
         rho = getattr(net, "test_correlation", 0.0) if len(rows) > 1 else 0.0
         shared = rng.normal()
         for i in rows:
-            sd = _seed_sd(net, None if truth_inputs is None else truth_inputs[i])
+            sd = seed_sd_at(net, None if truth_inputs is None else truth_inputs[i])
             out[i] = sd * (math.sqrt(rho) * shared + math.sqrt(1.0 - rho) * rng.normal())
     return out
 

@@ -100,7 +100,10 @@ class CampaignSpec:
             raise ConfigError(str(exc)) from None
 
     def to_json(self) -> str:
-        return json.dumps(dataclasses.asdict(self))  # key order kept: it is the column order
+        d = dataclasses.asdict(self)  # key order kept: it is the column order
+        if not d["neutral"]:
+            del d["neutral"]  # a plain design's spec reads as it did before the key existed (store hashes)
+        return json.dumps(d)
 
     @classmethod
     def from_json(cls, text: str) -> "CampaignSpec":
