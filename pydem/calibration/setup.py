@@ -22,10 +22,12 @@ TINY_STORES = ("data/campaigns/diag_ring_shear_tiny.h5", "data/campaigns/diag_ao
                "data/campaigns/diag_hopper_tiny.h5")
 # (aor_jku.h5: seed 000's three-parameter angle-of-repose campaign, pooled into the angle-of-repose
 # surrogates; diag_hopper_default.h5: the hopper's two-size runs, pooled into its size-spread store;
+# *_axes.h5: runs on the base model and its one-effect axes, pooled into their rig's store; all
 # their runs are points of the diagnosis box, pooled_runs.py)
-DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/diag_aor_default.h5",
-                  "data/campaigns/aor_jku.h5", "data/campaigns/diag_hopper_default_spread.h5",
-                  "data/campaigns/diag_hopper_default.h5")
+DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/diag_ring_shear_default_axes.h5",
+                  "data/campaigns/diag_aor_default.h5", "data/campaigns/aor_jku.h5",
+                  "data/campaigns/diag_aor_default_axes.h5", "data/campaigns/diag_hopper_default_spread.h5",
+                  "data/campaigns/diag_hopper_default.h5", "data/campaigns/diag_hopper_default_axes.h5")
 
 
 @dataclass
