@@ -136,8 +136,8 @@ def error_fall_text(sets: list[dict]) -> str:
         if hit:
             raw = np.median([s["error_after"] / s["error_before"] for s in hit])
             clean = [s["error_clean_after"] / s["error_clean_before"] for s in hit if s["error_clean_before"] > 0]
-            lines.append(f"{kind}: {len(hit)} named; error vs the rigs after/before, median {raw:.2f}; "
-                         f"scatter taken out {np.median(clean):.2f}")
+            lines.append(f"{kind}: {len(hit)} named; error vs the rigs after/before, median {raw:.2f}; scatter taken out "
+                         + (f"{np.median(clean):.2f}" if clean else "n/a (the error before at the scatter floor)"))
     return "\n".join(lines)
 
 
