@@ -80,15 +80,13 @@ def rerun(args):
                                                                          for j in range(len(obs))), flush=True)
 
 
-def dem_errors(row: dict, setup, noisy: list, d) -> dict:
+def dem_errors(row: dict, truth, setup, noisy: list, d) -> dict:
     """The fitted model's relative RMSE against the rigs' own values (before lab noise) before and
     after the chosen effect, and the floor the rigs' seed scatter puts under it (one run per test:
     the nets' error model at the truth). error_clean_*: the scatter's share taken out in quadrature,
     an estimate of the error against the rigs' mean response, as the surrogate sets measure it."""
     by_label = {r["label"]: r["value"] for r in row["rows"]}
     raw = {i: by_label[o.label] for i, o in enumerate(noisy)}
-    t = row["truth"]
-    truth = synthetic.Truth(t["theta"], t["effect"], t["parameter"], t["strength"])
     xs = synthetic.row_inputs(setup.nets, setup.candidates, truth, noisy)
     floor = float(np.sqrt(np.mean([(synthetic.seed_sd_at(setup.nets[o.quantity], x) / raw[i]) ** 2
                                    for i, (o, x) in enumerate(zip(noisy, xs))])))
@@ -108,12 +106,12 @@ def diagnose(args):
         row = json.loads(line)
         rng = np.random.default_rng(5000 + k)
         # rows of the given stores' rigs only
-        _, noisy = synthetic.journal_set(row, setup.nets, setup.candidates, rng,
+        truth, noisy = synthetic.journal_set(row, setup.nets, setup.candidates, rng,
                                          keep=lambda r: Quantity(r["rig"], r["metric"]) in setup.nets
                                          and r["rig"] not in args.skip_rigs)
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
-        errors = dem_errors(row, setup, noisy, d)
+        errors = dem_errors(row, truth, setup, noisy, d)
         out.append({"set": k, "kind": row["kind"], "truth": t, "verdict": d.verdict, "effect": d.effect,
                     "chi2_before": d.base.chi2_per_dof, "chi2_after": d.after.chi2_per_dof if d.after else None,
                     **errors,

@@ -20,13 +20,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pydem.calibration import synthetic  # noqa: E402
-from pydem.calibration.setup import DEFAULT_STORES, TINY_STORES, load_setup  # noqa: E402
+from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
 
 
 def main() -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--preset", default="tiny", help="which diagnosis stores: the shipped set of the preset (setup.py's "
-                    "DEFAULT_STORES, TINY_STORES), else data/campaigns/diag_<rig>_<preset>.h5")
+    ap.add_argument("--preset", default="tiny", help="which diagnosis stores: setup.shipped_stores(preset)")
     ap.add_argument("--source", choices=("surrogate", "dem"), default="surrogate")
     ap.add_argument("--sets", type=int, default=40, help="sets per candidate effect")
     ap.add_argument("--null", type=int, default=200, help="null sets (no hidden effect)")
@@ -38,9 +37,7 @@ def main() -> int:
     ap.add_argument("--exact-nets", action="store_true",
                     help="surrogate sets without the nets' own error (the nets taken as the rigs' exact mean; before 2026-11-25)")
     args = ap.parse_args()
-    shipped = {"default": DEFAULT_STORES, "tiny": TINY_STORES}.get(args.preset)
-    stores = ([ROOT / s for s in args.stores] if args.stores else [ROOT / s for s in shipped] if shipped else
-              [ROOT / f"data/campaigns/diag_{r}_{args.preset}.h5" for r in ("ring_shear", "aor", "hopper")])
+    stores = [ROOT / s for s in (args.stores or shipped_stores(args.preset))]
     args.preset = args.label or args.preset
     setup = load_setup([s for s in stores if s.exists()])
     kinds = {"null": args.null, **{c.name: args.sets for c in setup.candidates}, "unexplained": args.unexplained}

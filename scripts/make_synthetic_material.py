@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pydem.calibration import synthetic  # noqa: E402
-from pydem.calibration.setup import DEFAULT_STORES, TINY_STORES, load_setup  # noqa: E402
+from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
 
 
 def main() -> int:
@@ -40,11 +40,7 @@ def main() -> int:
     ap.add_argument("--journal", help="take the rigs' values and the truth from this diagnosis_dem_sets.py journal")
     ap.add_argument("--set", type=int, default=0, help="the journal's line (0-based)")
     a = ap.parse_args()
-    # the shipped store sets as pydem diagnose loads them (the default angle of repose pools the
-    # JKU runs): another set would train, and cache over, differently pooled nets
-    shipped = {"default": DEFAULT_STORES, "tiny": TINY_STORES}
-    stores = [ROOT / s for s in shipped[a.preset]] if a.preset in shipped else \
-        [ROOT / f"data/campaigns/diag_{r}_{a.preset}.h5" for r in ("ring_shear", "aor", "hopper")]
+    stores = [ROOT / s for s in shipped_stores(a.preset)]
     setup = load_setup([s for s in stores if s.exists()])
     rng = np.random.default_rng(a.seed)
     if a.journal:

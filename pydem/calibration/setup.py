@@ -30,6 +30,14 @@ DEFAULT_STORES = ("data/campaigns/diag_ring_shear_default.h5", "data/campaigns/d
                   "data/campaigns/diag_hopper_default.h5", "data/campaigns/diag_hopper_default_axes.h5")
 
 
+def shipped_stores(preset: str) -> list[str]:
+    """The diagnosis stores of a preset as `pydem diagnose` loads them (DEFAULT_STORES, TINY_STORES:
+    the pooled ones included, so nets are trained and cached for the same training sets), else
+    data/campaigns/diag_<rig>_<preset>.h5 of each rig; paths relative to the repository."""
+    shipped = {"default": DEFAULT_STORES, "tiny": TINY_STORES}
+    return list(shipped.get(preset, [f"data/campaigns/diag_{r}_{preset}.h5" for r in ("ring_shear", "aor", "hopper")]))
+
+
 @dataclass
 class Setup:
     stores: dict            # rig -> CampaignStore
