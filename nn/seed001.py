@@ -30,7 +30,7 @@ PARAMETERS = ("mu_pp", "mu_pw", "e_pp", "e_pw", "mu_r", "density", "diameter", "
 def parameter_row(case: str) -> dict[str, float]:
     """The case's 11 parameters; the diameter is the volume-weighted mean of its two sizes (the
     seed lists one d per case: its fine/coarse pair weighted by the fine volume fraction)."""
-    from pydem.rigs.hopper import TABLE1
+    from pydem.rigs.table1 import TABLE1
     n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[case]
     return {"mu_pp": mupp, "mu_pw": muwp, "e_pp": epp, "e_pw": ewp, "mu_r": mur, "density": float(rho),
             "diameter": phi * dd[0] + (1.0 - phi) * dd[1], "youngs_modulus": e_gpa * 1e9, "poisson_ratio": nu,
@@ -39,7 +39,7 @@ def parameter_row(case: str) -> dict[str, float]:
 
 def gra_tables(discharge: dict[str, float], rho: float = 0.5) -> dict[str, dict[str, float]]:
     """{group: {parameter: weight %}} for each packing (its cases in Table 1 order) and "all"."""
-    from pydem.rigs.hopper import TABLE1
+    from pydem.rigs.table1 import TABLE1
     groups = {p: [c for c in TABLE1 if c.split("-")[0] == p and c in discharge] for p in ("A", "B1", "B2", "B3", "B4")}
     groups["all"] = [c for c in TABLE1 if c in discharge]
     out = {}
@@ -92,7 +92,7 @@ def write_subset(full: str, out: str, every: int):
 
 
 def main(argv=None, prog: str = "python -m nn.seed001") -> int:
-    from pydem.rigs.hopper import TABLE1
+    from pydem.rigs.table1 import TABLE1
     ap = argparse.ArgumentParser(prog=prog)
     sub = ap.add_subparsers(dest="cmd", required=True)
     f = sub.add_parser("frames", help="run the Table 1 cases into the frame store (resumable)")
@@ -118,6 +118,13 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         e.add_argument("--every", type=int, help="use every N-th stored frame (compare, point-to-point)")
         e.add_argument("--seed", type=int, default=0)
         e.add_argument("--threads", type=int, default=2, help="torch threads")
+        if name != "process":
+            e.add_argument("--checkpoints", help="folder of the training checkpoints (default: --out)")
+        e.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
+                       help="auto (default): a GPU when torch sees one, else the CPU")
+        if name == "compare":
+            e.add_argument("--models", nargs="+", help="a subset of alexnet resnet50 vgg16 vgg19")
+            e.add_argument("--time-budget", type=float, help="s of training per network after which no epoch starts")
         if name == "process":
             e.add_argument("--protocol", choices=("pretrained", "per-case"), default="pretrained",
                            help="pretrained: on other cases' whole discharges, fine-tuned on the case's first 20 %% "
@@ -142,6 +149,11 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         from . import seed001_experiments as ex
         torch.set_num_threads(args.threads)
         kw = {k: v for k, v in (("epochs", args.epochs), ("every", args.every)) if v is not None}
+        kw["device"] = args.device
+        if args.cmd != "process":
+            kw["checkpoints"] = args.checkpoints
+        if args.cmd == "compare":
+            kw |= {k: v for k, v in (("models", args.models), ("time_budget", args.time_budget)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
             kw["protocol"] = args.protocol

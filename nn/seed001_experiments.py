@@ -35,9 +35,11 @@ def _packing(case: str) -> str:
     return case.split("-")[0]
 
 
-def _machine() -> str:
+def _machine(device: torch.device | None = None) -> str:
     import os
-    return f"{platform.machine()}, {len(os.sched_getaffinity(0))} cores, torch {torch.__version__}, {torch.get_num_threads()} threads"
+    where = f", on {torch.cuda.get_device_name(device)}" if device is not None and device.type == "cuda" else ""
+    return (f"{platform.machine()}, {len(os.sched_getaffinity(0))} cores, torch {torch.__version__}, "
+            f"{torch.get_num_threads()} threads{where}")
 
 
 def _beverloo_per_frame(f: images.Frames, train_cases, first_frames: dict) -> tuple[np.ndarray, dict]:
@@ -56,33 +58,48 @@ def _first_frames(store, size: int) -> dict:
     return {c: images.shrink(s.read_case(c)["frames"][:1], size)[0] for c in s.cases()}
 
 
-def _train(name: str, build, f: images.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say):
+def _train(name: str, build, f: images.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say,
+           device: torch.device = torch.device("cpu"), time_budget: float | None = None):
     torch.manual_seed(seed)
-    model = build()
+    model = build().to(device)
     t0 = time.perf_counter()
     scaling = images.fit(model, f.x[tr], f.remaining[tr], f.x[va], f.remaining[va], epochs=epochs, batch=batch, lr=lr,
-                         seed=seed, checkpoint=out / f"{name}.pt", progress=images.Progress(say))
+                         seed=seed, checkpoint=out / f"{name}.pt", progress=images.Progress(say), time_budget=time_budget)
     seconds = time.perf_counter() - t0
     return model, scaling, seconds
 
 
 def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: int = 32, lr: float = 1e-4,
-            models=tuple(cnn.BACKBONES), seed: int = 0, say=print) -> dict:
+            models=tuple(cnn.BACKBONES), seed: int = 0, device: str = "auto", time_budget: float | None = None,
+            checkpoints=None, say=print) -> dict:
+    """`time_budget`: seconds of training per network after which no further epoch starts (each
+    network's row says how many epochs it had); `checkpoints`: their folder when not `out` (a
+    VGG's with its optimiser state is 1.6 GB)."""
+    unknown = sorted(set(models) - set(cnn.BACKBONES))
+    if unknown:
+        raise ValueError(f"networks {unknown}: not among {sorted(cnn.BACKBONES)}")
     out = Path(out)
+    dev = images.pick_device(device)
     f = images.load_frames(store, size=size, every=every)
     tr, va, te = images.random_split(len(f.x), seed)
-    say(f"compare: {len(f.x)} frames of {len(f.discharge)} cases at {size} x {size}; train {len(tr)}, validation {len(va)}, test {len(te)}")
+    say(f"compare: {len(f.x)} frames of {len(f.discharge)} cases at {size} x {size}; train {len(tr)}, validation {len(va)}, "
+        f"test {len(te)}; on {dev}")
     res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
-                        "frames": int(len(f.x)), "split": "random 60/20/20 over frames"}, "machine": _machine(), "models": {}}
+                        "frames": int(len(f.x)), "split": "random 60/20/20 over frames", "device": str(dev)}
+           | ({"time_budget_s": time_budget} if time_budget is not None else {}),
+           "machine": _machine(dev), "models": {}}
     for name in models:
         say(f"- {name}")
-        model, scaling, seconds = _train(name, cnn.BACKBONES[name], f, tr, va, epochs, batch, lr, seed, out, say)
+        model, scaling, seconds = _train(name, cnn.BACKBONES[name], f, tr, va, epochs, batch, lr, seed,
+                                         Path(checkpoints or out), say, dev, time_budget)
         t0 = time.perf_counter()
         pred = images.predict(model, f.x[te], scaling)
         per_frame = (time.perf_counter() - t0) / max(len(te), 1)
         res["models"][name] = images.scores(f.remaining[te], pred) | {
-            "train_seconds": seconds, "predict_ms_per_frame": 1e3 * per_frame, "parameters": cnn.parameter_count(model)}
+            "train_seconds": seconds, "epochs_run": len(scaling["history"]),
+            "predict_ms_per_frame": 1e3 * per_frame, "parameters": cnn.parameter_count(model)}
         say(f"  {name}: " + ", ".join(f"{k} {v:.4g}" for k, v in res["models"][name].items()))
+        _save(out / "compare.json", res)  # each network's row is kept as soon as it exists
     base, law = _beverloo_per_frame(f, sorted(f.discharge), _first_frames(store, size))
     res["baseline"] = images.scores(f.remaining[te], base[te]) | {"law": law}
     _save(out / "compare.json", res)
@@ -90,23 +107,26 @@ def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: 
 
 
 def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12, batch: int = 32, lr: float = 1e-4,
-                   seed: int = 0, say=print) -> dict:
+                   seed: int = 0, device: str = "auto", checkpoints=None, say=print) -> dict:
     out = Path(out)
+    dev = images.pick_device(device)
     f = images.load_frames(store, size=size, every=every)
     cases = sorted(f.discharge)
     test_cases = [c for c in cases if c.endswith("-5")]       # one case of every packing
     val_cases = [c for c in cases if c.endswith("-4")]
     first = _first_frames(store, size)
     res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
-                        "frames": int(len(f.x)), "test_cases": test_cases, "validation_cases": val_cases},
-           "machine": _machine(), "splits": {}}
+                        "frames": int(len(f.x)), "test_cases": test_cases, "validation_cases": val_cases,
+                        "device": str(dev)},
+           "machine": _machine(dev), "splits": {}}
     for split, (tr, va, te) in (("random_frames", images.random_split(len(f.x), seed)),
                                 ("leave_cases_out", images.case_split(f.case, test_cases, val_cases))):
         say(f"- AlexNet-FC, {split}: train {len(tr)}, validation {len(va)}, test {len(te)} frames")
         if not (len(tr) and len(va) and len(te)):
             say("  an empty part (leave-cases-out holds out the -5 cases and validates on the -4 cases): skipped")
             continue
-        model, scaling, seconds = _train(f"alexnet_fc_{split}", cnn.AlexNetFC, f, tr, va, epochs, batch, lr, seed, out, say)
+        model, scaling, seconds = _train(f"alexnet_fc_{split}", cnn.AlexNetFC, f, tr, va, epochs, batch, lr, seed,
+                                         Path(checkpoints or out), say, dev)
         pred = images.predict(model, f.x[te], scaling)
         train_cases = sorted(set(f.case[tr]))
         base, law = _beverloo_per_frame(f, train_cases, first)
@@ -147,7 +167,7 @@ def _window_mse(model, xw, yw, scaling: dict) -> float:
 
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
-            say=print) -> dict:
+            device: str = "auto", say=print) -> dict:
     """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
 
     protocol "per-case" (seed 001's): the CNN-LSTM trained on windows of the case's first
@@ -164,10 +184,11 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
     epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
+    dev = images.pick_device(device)
     res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
-                        "protocol": protocol, "gradient_clip": LSTM_CLIP} | ({"stride": stride, "finetune_epochs": finetune_epochs,
+                        "protocol": protocol, "gradient_clip": LSTM_CLIP, "device": str(dev)} | ({"stride": stride, "finetune_epochs": finetune_epochs,
                                                   "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
-           "machine": _machine(), "cases": {}}
+           "machine": _machine(dev), "cases": {}}
     cases = FrameStore(store).cases()
     data = {c: images.load_frames(store, cases=[c], size=size) for c in cases}
     folds = sorted({_fold(c) for c in cases})
@@ -185,7 +206,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
                 f"(validation: fold {val_fold}, {len(xv)} windows)")
             torch.manual_seed(seed)
-            model = cnn.CNNLSTM()
+            model = cnn.CNNLSTM().to(dev)
             t0 = time.perf_counter()
             scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
                                  checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=images.Progress(say))
@@ -202,7 +223,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         t0 = time.perf_counter()
         if protocol == "per-case":
             torch.manual_seed(seed)
-            model = cnn.CNNLSTM()
+            model = cnn.CNNLSTM().to(dev)
             scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
                                  lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
         else:

@@ -28,35 +28,8 @@ from .checkpoint import Checkpoint, CheckpointStop, signature
 from .common import Frames, diameters_from_table, Stepper, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
 from .result import Metric, RigResult
+from .table1 import TABLE1, species_counts  # noqa: F401  (re-exported: the rig's cases by name)
 
-# seed 001, Table 1: N, nu, E (GPa), fine volume fraction, e_pp, e_wp, mu_pp, mu_wp, mu_r, d (mm), rho
-TABLE1 = {
-    "A-1": (620, 0.35, 0.01, 0.2, 0.3, 0.1, 0.5, 0.2, 0.08, (6, 9), 2800),
-    "A-2": (10180, 0.26, 0.375, 0.5, 0.5, 0.8, 0.6, 0.7, 0.02, (3, 6), 2100),
-    "A-3": (5450, 0.42, 0.065, 0.2, 0.4, 0.7, 0.9, 0.2, 0.05, (3, 6), 1800),
-    "A-4": (14700, 0.3, 0.01, 0.8, 0.7, 0.3, 0.2, 0.9, 0.07, (3, 9), 2500),
-    "A-5": (7900, 0.4, 0.01, 0.4, 0.9, 0.1, 0.7, 0.1, 0.01, (3, 9), 2800),
-    "B1-1": (6875, 0.42, 0.01, 0.3, 0.9, 0.9, 0.3, 0.3, 0.06, (3, 6), 1500),
-    "B1-2": (7596, 0.33, 0.01, 0.4, 0.4, 0.8, 0.4, 0.2, 0.03, (3, 9), 1500),
-    "B1-3": (1239, 0.42, 0.01, 0.4, 0.3, 0.5, 0.2, 0.1, 0.08, (6, 9), 1800),
-    "B1-4": (2394, 0.3, 0.375, 0.1, 0.7, 0.1, 0.4, 0.5, 0.08, (3, 9), 2100),
-    "B1-5": (8464, 0.4, 0.065, 0.4, 0.5, 0.3, 0.5, 0.9, 0.06, (3, 6), 2800),
-    "B2-1": (1239, 0.26, 0.375, 0.4, 0.6, 0.7, 0.5, 0.7, 0.04, (6, 9), 2800),
-    "B2-2": (3696, 0.45, 0.01, 0.1, 0.2, 0.2, 0.9, 0.2, 0.09, (3, 6), 2500),
-    "B2-3": (8464, 0.35, 0.01, 0.4, 0.8, 0.2, 0.5, 0.8, 0.06, (3, 6), 2100),
-    "B2-4": (1094, 0.3, 0.01, 0.3, 0.9, 0.9, 0.1, 0.7, 0.01, (6, 9), 2100),
-    "B2-5": (9330, 0.4, 0.2, 0.5, 0.1, 0.1, 0.8, 0.2, 0.02, (3, 9), 1800),
-    "B3-1": (5285, 0.26, 0.01, 0.2, 0.6, 0.3, 0.3, 0.2, 0.01, (3, 6), 2500),
-    "B3-2": (4128, 0.4, 0.2, 0.2, 0.7, 0.1, 0.3, 0.1, 0.07, (3, 9), 2800),
-    "B3-3": (950, 0.4, 0.375, 0.2, 0.3, 0.1, 0.2, 0.1, 0.09, (6, 9), 2100),
-    "B3-4": (5862, 0.35, 0.065, 0.3, 0.9, 0.8, 0.6, 0.6, 0.04, (3, 9), 2100),
-    "B3-5": (5170, 0.35, 0.2, 0.2, 0.8, 0.9, 0.8, 0.9, 0.02, (3, 6), 2800),
-    "B4-1": (6874, 0.35, 0.2, 0.3, 0.8, 0.4, 0.9, 0.3, 0.02, (3, 6), 1500),
-    "B4-2": (9330, 0.33, 0.01, 0.5, 0.6, 0.1, 0.6, 0.8, 0.04, (3, 9), 2500),
-    "B4-3": (805, 0.2, 0.375, 0.1, 0.1, 0.9, 0.1, 0.1, 0.05, (6, 9), 2100),
-    "B4-4": (1094, 0.2, 0.065, 0.3, 0.5, 0.5, 0.2, 0.8, 0.09, (6, 9), 2100),
-    "B4-5": (4128, 0.2, 0.375, 0.2, 0.9, 0.2, 0.3, 0.9, 0.08, (3, 9), 2100),
-}
 PACKINGS = ("A", "B1", "B2", "B3", "B4")
 
 
@@ -137,13 +110,6 @@ def apply_case(cfg: HopperConfig, name: str):
     # presses it beyond 0.3 of the fine radius (A-5 stopped there); the limit only detects
     # blow-ups and changes no trajectory that stays below it
     cfg.max_overlap_ratio = 0.6
-
-
-def species_counts(n: int, d_small: float, d_large: float, fine_fraction: float) -> tuple[int, int]:
-    """(fine, coarse) numbers whose fine volume fraction is closest to fine_fraction."""
-    ratio = (d_large / d_small) ** 3  # a coarse sphere holds `ratio` fine volumes
-    n_fine = round(n * fine_fraction * ratio / (fine_fraction * ratio + (1.0 - fine_fraction)))
-    return int(n_fine), int(n - n_fine)
 
 
 class Hopper:

@@ -103,3 +103,26 @@ def test_windows_for_the_sequence_model():
     x = np.arange(6, dtype=np.float32).reshape(6, 1, 1, 1)
     w, y = images.windows(x, np.arange(6.0), 4)
     assert w.shape == (3, 4, 1, 1, 1) and y.tolist() == [[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]]
+
+
+def test_a_time_budget_stops_training_after_the_epoch_that_spends_it_and_a_rerun_goes_on(tmp_path):
+    torch.set_num_threads(1)
+    x, y = blobs(32)
+    xv, yv = blobs(8, seed=1)
+    ck = tmp_path / "fc.pt"
+    torch.manual_seed(0)
+    short = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck, time_budget=0.0)
+    assert [e["epoch"] for e in short["history"]] == [1]
+    torch.manual_seed(0)
+    rest = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck)
+    assert [e["epoch"] for e in rest["history"]] == [1, 2, 3, 4]
+
+
+def test_the_device_is_the_gpu_only_when_there_is_one():
+    assert images.pick_device("cpu").type == "cpu"
+    assert images.pick_device("auto").type == ("cuda" if torch.cuda.is_available() else "cpu")
+    with pytest.raises(ValueError, match="device"):
+        images.pick_device("tpu")
+    if not torch.cuda.is_available():
+        with pytest.raises(ValueError, match="no GPU"):
+            images.pick_device("cuda")

@@ -3,6 +3,7 @@ Table 1, every 20th frame of the full set; docs/seed001.md): the stored labels a
 with the physics of a discharge, the GRA weights are percentages, and the two cheap experiments
 and the report run end to end (tiny settings: this checks the chain, not the networks' skill)."""
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -85,3 +86,17 @@ def test_fit_keeps_a_given_target_scaling():
     x = np.linspace(0, 1, 16, dtype=np.float32).reshape(-1, 1)
     s = fit(model, x, 2 * x[:, 0], x, 2 * x[:, 0], epochs=1, batch=8, scaling={"mean": 5.0, "sd": 3.0})
     assert (s["mean"], s["sd"]) == (5.0, 3.0)
+
+
+def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
+    """bench/seed001_device.py runs on GPU machines where libdem is not built: pydem's frame
+    store and Table 1 must import there without the binding."""
+    import subprocess
+    import sys
+    code = ("import sys; sys.path.insert(0, 'bench'); import seed001_device as d; d.import_without_binding(); "
+            "import pydem.frames, pydem.rigs.table1, nn.images; "
+            "assert 'pydem._libdem' not in sys.modules; print(len(pydem.rigs.table1.TABLE1))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         env={**os.environ, "SEED001_NO_BINDING": "1"})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[-1] == "25"
