@@ -61,14 +61,16 @@ def compare_section(res: dict):
     for name, r in res["models"].items():
         seed = SEED_TABLE2.get(name, (None,) * 3)
         rows.append([name, _f(1e3 * r["mae"]), _f(1e3 * r["rmse"]), _f(r["r2"]), _f(seed[0]), _f(seed[1]), _f(seed[2]),
-                     f"{r['train_seconds']:.0f}", _f(r["predict_ms_per_frame"])])
+                     str(r.get("epochs_run", res["settings"]["epochs"])), f"{r['train_seconds']:.0f}",
+                     _f(r["predict_ms_per_frame"])])
     b = res["baseline"]
-    rows.append(["Beverloo x fill fraction", _f(1e3 * b["mae"]), _f(1e3 * b["rmse"]), _f(b["r2"]), "", "", "", "", ""])
-    md, h = _table(rows, ["network", "MAE (ms)", "RMSE (ms)", "R^2", "seed MAE", "seed RMSE", "seed R^2", "train s",
-                          "predict ms/frame"])
+    rows.append(["Beverloo x fill fraction", _f(1e3 * b["mae"]), _f(1e3 * b["rmse"]), _f(b["r2"]), "", "", "", "", "", ""])
+    md, h = _table(rows, ["network", "MAE (ms)", "RMSE (ms)", "R^2", "seed MAE", "seed RMSE", "seed R^2", "epochs",
+                          "train s", "predict ms/frame"])
     st = res["settings"]
-    line = (f"{st['frames']} frames at {st['size']} x {st['size']}, {st['split']}, {st['epochs']} epochs, batch "
-            f"{st['batch']}, Adam lr {st['lr']}; {res['machine']}.")
+    budget = f" or {st['time_budget_s']:.0f} s of training, whichever came first" if "time_budget_s" in st else ""
+    line = (f"{st['frames']} frames at {st['size']} x {st['size']}, {st['split']}, up to {st['epochs']} epochs{budget}, "
+            f"batch {st['batch']}, Adam lr {st['lr']}; {res['machine']}.")
     return "Four CNNs on the remaining discharge time (seed 001 Table 2)", line + "\n\n" + md, f"<p>{line}</p>" + h
 
 
