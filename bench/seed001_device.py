@@ -1,19 +1,19 @@
-"""Seed 001's four-CNN comparison and AlexNet-FC at the seed's scale — 224 x 224 frames, every
-stored frame — on a GPU machine, where pydem's compiled binding is usually not built (another
-Python, no HDF5 headers): the image networks need only torch, h5py and numpy, and this runner
-imports pydem's pure-Python modules (the frame store, Table 1) without the binding.
+"""Seed 001's image experiments on a GPU machine, where pydem's compiled binding is usually not
+built (another Python, no HDF5 headers): the image networks need only torch, h5py and numpy, so
+this runner imports pydem's pure-Python modules (the frame store, Table 1) without the binding
+and then runs `pydem images`' own command line (nn/seed001.py) with the same arguments.
+The seed-scale comparison of docs/seed001.md (224 x 224, every frame):
 
-    python3 bench/seed001_device.py --store data/seed001/frames_full.h5 --out OUT [--epochs 30 --time-budget 90]
+    python3 bench/seed001_device.py compare --store data/seed001/frames_full.h5 --out OUT \\
+        --size 224 --every 1 --epochs 30 --time-budget 75 --checkpoints /tmp/seed001_checkpoints
+    python3 bench/seed001_device.py point-to-point --store data/seed001/frames_full.h5 --out OUT \\
+        --size 224 --every 1 --epochs 30 --checkpoints /tmp/seed001_checkpoints
 
-Writes OUT/compare.json (after every network, so a run cut short keeps what finished) and
-OUT/point_to_point.json; checkpoints go to a scratch folder (a VGG's is 1.6 GB). The CPU runs
-use the same code through `pydem images compare|point-to-point`; docs/seed001.md has both."""
+(checkpoints outside OUT: a VGG's is 1.6 GB)."""
 from __future__ import annotations
 
-import argparse
 import os
 import sys
-import time
 import types
 from pathlib import Path
 
@@ -39,34 +39,9 @@ def import_without_binding():
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--store", required=True)
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--size", type=int, default=224)
-    ap.add_argument("--every", type=int, default=1)
-    ap.add_argument("--epochs", type=int, default=30)
-    ap.add_argument("--p2p-epochs", type=int, default=30)
-    ap.add_argument("--time-budget", type=float, default=90.0, help="s of training per network (compare)")
-    ap.add_argument("--models", nargs="+", default=["alexnet", "resnet50", "vgg16", "vgg19"])
-    ap.add_argument("--scratch", default="/tmp/seed001_checkpoints")
-    ap.add_argument("--device", default="auto")
-    args = ap.parse_args(argv)
     import_without_binding()
-    import torch
-    from nn import seed001_experiments as ex
-    if torch.cuda.is_available():
-        torch.backends.cudnn.benchmark = True  # fixed input shapes: let cuDNN pick its fastest kernels
-        print(f"torch {torch.__version__} on {torch.cuda.get_device_name(0)}", flush=True)
-    say = lambda m: print(m, flush=True)  # noqa: E731
-    t0 = time.perf_counter()
-    ex.compare(args.store, args.out, size=args.size, every=args.every, epochs=args.epochs, models=args.models,
-               device=args.device, time_budget=args.time_budget, checkpoints=Path(args.scratch) / "compare", say=say)
-    say(f"compare done in {time.perf_counter() - t0:.0f} s")
-    t0 = time.perf_counter()
-    ex.point_to_point(args.store, args.out, size=args.size, every=args.every, epochs=args.p2p_epochs,
-                      device=args.device, checkpoints=Path(args.scratch) / "p2p", say=say)
-    say(f"point-to-point done in {time.perf_counter() - t0:.0f} s")
-    return 0
+    from nn.seed001 import main as seed001
+    return seed001(argv, prog="bench/seed001_device.py")
 
 
 if __name__ == "__main__":

@@ -148,6 +148,8 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         import torch
         from . import seed001_experiments as ex
         torch.set_num_threads(args.threads)
+        if torch.cuda.is_available():
+            torch.backends.cudnn.benchmark = True  # fixed input shapes: cuDNN may pick its fastest kernels
         kw = {k: v for k, v in (("epochs", args.epochs), ("every", args.every)) if v is not None}
         kw["device"] = args.device
         if args.cmd != "process":
