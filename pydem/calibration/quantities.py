@@ -26,6 +26,23 @@ QUANTITIES = {
     "hopper": {"mass_flow_rate": ("slot_width",), "discharge_time": ("slot_width",), "bulk_density": ("slot_width",)},
 }
 _FRACTION_METRIC = re.compile(r"^mu_ie_s_(\d+)$")
+# A hopper run that did not empty (it jammed, or flowed too slowly for the time limit) measured no
+# discharge time, and no flow rate either: its 20-80 % slope mixes flow with an arch's standstill
+# (a run that jammed after 1.8 kg/s reports 0.3). Such runs are neither measurements (rig_values)
+# nor surrogate training rows or replicates (counted_runs): with them in, the default stores' flow-rate net
+# had a cross-validated R^2 of 0.965 (RMSE 0.139 kg/s) and predicted negative flows in 5 % of the
+# box; without, 0.982 (0.091 kg/s).
+DISCHARGE_METRICS = ("mass_flow_rate", "discharge_time")
+
+
+def counted_runs(store, column: str) -> np.ndarray:
+    """(runs,) bool: the store's finished runs whose value in metric column `column` counts as a
+    measurement: finite, and for a hopper's discharge metrics, from a hopper that emptied."""
+    j = store.metric_names.index(column)
+    ok = (store.status == 1) & np.isfinite(store.values[:, j])
+    if store.spec.rig == "hopper" and column in DISCHARGE_METRICS and "discharge_time" in store.metric_names:
+        ok &= np.isfinite(store.values[:, store.metric_names.index("discharge_time")])
+    return ok
 
 
 @dataclass(frozen=True)
@@ -128,16 +145,15 @@ def training_tables(store, pooled=()) -> dict[Quantity, tuple[list[str], np.ndar
         q = Quantity(rig, metric)
         xs, ys, fractions = [], [], set()
         for st, params in sources:
-            done = st.status == 1
             if metric == "mu_ie_s":
                 for j, frac in fraction_columns(st.metric_names):
-                    ok = done & np.isfinite(st.values[:, j])
+                    ok = counted_runs(st, st.metric_names[j])
                     xs.append(np.column_stack([params[ok], np.full(ok.sum(), frac)]))
                     ys.append(st.values[ok, j])
                     fractions.add(frac)
             elif metric in st.metric_names:
                 j = st.metric_names.index(metric)
-                ok = done & np.isfinite(st.values[:, j])
+                ok = counted_runs(st, metric)
                 xs.append(params[ok])
                 ys.append(st.values[ok, j])
         if not xs:

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .quantities import Quantity, fraction_columns, training_tables
+from .quantities import Quantity, counted_runs, fraction_columns, training_tables
 
 NET_FORMAT = 3  # 3: bagged nets with an error model, log target where it fits better (older caches are retrained)
 SIZES = (3, 6, 10, 16)  # hidden units per bagged member, chosen by the cross-validated RMSE
@@ -205,10 +205,11 @@ def seed_scatter(store) -> dict[Quantity, float]:
             names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
         ss, dof = 0.0, 0
         for m in names:
-            _, means, counts, sd = store.point_table(m)
-            k = int((counts - 1).sum())
-            if k > 0 and np.isfinite(sd):
-                ss, dof = ss + sd * sd * k, dof + k
+            ok = counted_runs(store, m)
+            y = store.values[ok, store.metric_names.index(m)]
+            _, inverse, counts = np.unique(store.points[ok], return_inverse=True, return_counts=True)
+            means = np.bincount(inverse, weights=y) / np.maximum(counts, 1)
+            ss, dof = ss + float(((y - means[inverse]) ** 2).sum()), dof + int((counts - 1).sum())
         if dof > 0:
             out[Quantity(rig, metric)] = float(np.sqrt(ss / dof))
     return out
@@ -229,7 +230,7 @@ def replicate_groups(store, rep, net: QuantityNet) -> tuple[np.ndarray, np.ndarr
     sd, dof, xs = [], [], []
     for j, frac in cols:
         for p in np.unique(rep.points):
-            k = (rep.points == p) & (rep.status == 1) & np.isfinite(rep.values[:, j])
+            k = (rep.points == p) & counted_runs(rep, rep.metric_names[j])
             if k.sum() < 2:
                 continue
             x = params[k][0] if frac is None or "shear_fraction" not in net.input_names else np.r_[params[k][0], frac]
@@ -310,6 +311,9 @@ def store_hash(store, pooled=()) -> str:
         h.update(json.dumps(st.metric_names).encode())
         for a in (st.params, st.values, st.status):
             h.update(np.ascontiguousarray(a).tobytes())
+    for q, (names, x, y) in sorted(training_tables(store, pooled).items(), key=lambda kv: kv[0].key):
+        h.update(f"{q.key} {names}".encode())  # the rows trained on: a change of which runs count retrains
+        h.update(np.ascontiguousarray(x).tobytes() + np.ascontiguousarray(y).tobytes())
     return h.hexdigest()[:16]
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import Observation, Quantity, rig_metric, test_conditions
+from .quantities import DISCHARGE_METRICS, Observation, Quantity, rig_metric, test_conditions
 
 NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
          "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
@@ -247,8 +247,8 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
         for i in idx:
             o = obs[i]
             metric = rig_metric(o)
-            if jammed and metric in ("mass_flow_rate", "discharge_time"):
-                continue  # a hopper that jammed measured neither a flow rate nor a discharge time
+            if jammed and metric in DISCHARGE_METRICS:
+                continue  # a hopper that did not empty measured neither a flow rate nor a discharge time
             v = res.metrics[metric].value if metric in res.metrics else None
             if isinstance(v, float) and math.isfinite(v) and v > 0:
                 values[i] = v

@@ -71,3 +71,17 @@ def test_a_different_blow_up_limit_does_not_block_pooling():
     with pytest.raises(PoolError, match="the rig differs in fine_fraction"):
         check_poolable(main, store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]], rig="hopper",
                                    fixed={"fine_fraction": 0.5}))
+
+
+def test_a_hopper_that_did_not_empty_trains_no_discharge_metric():
+    """A run that jammed measured no discharge time and no flow rate (its 20-80 % slope mixes flow
+    and standstill): neither surrogate learns from it, as no pseudo-measurement contains it
+    (synthetic.rig_values); its bulk density, measured before the gate opened, still counts."""
+    ranges = {"friction": (0.05, 1.0), "slot_width": (0.03, 0.08)}
+    main = store("hopper.h5", ranges, [[0.3, 0.05], [0.9, 0.04]], [[1.2, 1.1, 1300.0], [np.nan, 0.3, 1250.0]],
+                 preset="default", rig="hopper")
+    main.metric_names = ["discharge_time", "mass_flow_rate", "bulk_density"]
+    tables = training_tables(main)
+    assert list(tables[Quantity("hopper", "mass_flow_rate")][2]) == [1.1]
+    assert list(tables[Quantity("hopper", "discharge_time")][2]) == [1.2]
+    assert list(tables[Quantity("hopper", "bulk_density")][2]) == [1300.0, 1250.0]
