@@ -8,6 +8,8 @@ diagnosis on the given stores.
 
     .venv/bin/python bench/diagnosis_dem_sets.py run --kinds null cohesion_sjkr --journal bench/results/dem_sets_default.jsonl
     .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl
+    .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl --kinds null \
+        --density-factor 1.25 --out bench/results/dem_sets_default.density125.diagnosed.json
     .venv/bin/python bench/diagnosis_dem_sets.py rerun --rig aor --journal bench/results/dem_sets_default.jsonl
 """
 from __future__ import annotations
@@ -104,11 +106,18 @@ def diagnose(args):
     out = []
     for k, line in enumerate(Path(args.journal).read_text().splitlines()):
         row = json.loads(line)
+        if args.kinds and row["kind"] not in args.kinds:
+            continue
         rng = np.random.default_rng(5000 + k)
         # rows of the given stores' rigs only
         truth, noisy = synthetic.journal_set(row, setup.nets, setup.candidates, rng,
                                          keep=lambda r: Quantity(r["rig"], r["metric"]) in setup.nets
                                          and r["rig"] not in args.skip_rigs)
+        if args.density_factor is not None:  # a discrepancy no candidate represents (synthetic.density_mismatch)
+            noisy = synthetic.density_mismatch(noisy, args.density_factor)
+            row = {**row, "rows": [{**r, "value": r["value"] * args.density_factor
+                                    if r["metric"] in ("bulk_density", "mass_flow_rate") and r["value"] is not None
+                                    else r["value"]} for r in row["rows"]]}
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]
         errors = dem_errors(row, truth, setup, noisy, d)
@@ -152,6 +161,9 @@ def main() -> int:
     d.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
     d.add_argument("--skip-rigs", nargs="*", default=[], help="leave these rigs' rows out (e.g. rows made at an older preset)")
     d.add_argument("--out", help="verdicts file (default: the journal's name with .diagnosed.json)")
+    d.add_argument("--kinds", nargs="*", help="only the sets of these kinds (e.g. null)")
+    d.add_argument("--density-factor", type=float, help="every bulk density and mass flow rate times this factor: a "
+                   "solid density the model does not know, a discrepancy no candidate explains (expected: unexplained)")
     e = sub.add_parser("rerun", help="run one rig's rows again at its current preset")
     e.add_argument("--journal", required=True)
     e.add_argument("--rig", required=True)
