@@ -186,48 +186,56 @@ def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prio
     net.err_c0, net.err_c = float(res.x[0]), res.x[1:].copy()
 
 
-def replicate_store_path(store, pooled=()) -> Path | None:
-    """Where a store's seed-scatter companion lives: <name>_replicates.h5 next to it, else that of
-    the first store pooled with it that has one (same rig and preset); None if none has."""
-    paths = (st.path.with_name(st.path.stem + "_replicates.h5") for st in (store, *pooled))
-    return next((p for p in paths if p.exists()), None)
+def replicate_store_paths(store, pooled=()) -> list[Path]:
+    """Where a store's seed-scatter companions live: <name>_replicates.h5 next to it and next to
+    each store pooled with it (same rig and preset), those that exist. Several: replicates over
+    the whole box and on the one-effect axes, where the base model's scatter is (the box's
+    replicate points are nearly all cohesive)."""
+    paths = [st.path.with_name(st.path.stem + "_replicates.h5") for st in (store, *pooled)]
+    return [p for p in paths if p.exists()]
 
 
-def seed_scatter(store) -> dict[Quantity, float]:
-    """Pooled seed-to-seed standard deviation of one run per quantity, from a store with
-    replicates (the shear points of one quantity pooled together)."""
+def seed_scatter(reps) -> dict[Quantity, float]:
+    """Pooled seed-to-seed standard deviation of one run per quantity, from replicate stores
+    (the shear points of one quantity pooled together)."""
     from .quantities import QUANTITIES
-    out = {}
-    rig = store.spec.rig
-    for metric in QUANTITIES[rig]:
-        names = [metric] if metric in store.metric_names else []
-        if metric == "mu_ie_s":
-            names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
-        ss, dof = 0.0, 0
-        for m in names:
-            ok = counted_runs(store, m)
-            y = store.values[ok, store.metric_names.index(m)]
-            _, inverse, counts = np.unique(store.points[ok], return_inverse=True, return_counts=True)
-            means = np.bincount(inverse, weights=y) / np.maximum(counts, 1)
-            ss, dof = ss + float(((y - means[inverse]) ** 2).sum()), dof + int((counts - 1).sum())
-        if dof > 0:
-            out[Quantity(rig, metric)] = float(np.sqrt(ss / dof))
-    return out
+    acc: dict[Quantity, list] = {}
+    for store in reps:
+        rig = store.spec.rig
+        for metric in QUANTITIES[rig]:
+            names = [metric] if metric in store.metric_names else []
+            if metric == "mu_ie_s":
+                names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
+            a = acc.setdefault(Quantity(rig, metric), [0.0, 0])
+            for m in names:
+                ok = counted_runs(store, m)
+                y = store.values[ok, store.metric_names.index(m)]
+                _, inverse, counts = np.unique(store.points[ok], return_inverse=True, return_counts=True)
+                means = np.bincount(inverse, weights=y) / np.maximum(counts, 1)
+                a[0] += float(((y - means[inverse]) ** 2).sum())
+                a[1] += int((counts - 1).sum())
+    return {q: float(np.sqrt(ss / dof)) for q, (ss, dof) in acc.items() if dof > 0}
 
 
-def replicate_groups(store, rep, net: QuantityNet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(sd, dof, inputs) of every replicated point of `rep` (each shear point its own group) for
-    the net's quantity: the runs' sample sd at the point, its degrees of freedom (runs - 1), and
-    the point's inputs in the net's columns (`rep`'s parameters mapped into `store`'s, as pooling
-    does, plus the shear fraction)."""
+def replicate_groups(store, reps, net: QuantityNet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sd, dof, inputs) of every replicated point of the replicate stores `reps` (each shear
+    point its own group) for the net's quantity: the runs' sample sd at the point, its degrees of
+    freedom (runs - 1), and the point's inputs in the net's columns (each replicate store's
+    parameters mapped into `store`'s, as pooling does, plus the shear fraction)."""
     from .pooled_runs import pooled_params
     q = net.quantity
-    params = pooled_params(store, rep)
+    sd, dof, xs = [], [], []
+    for rep in reps:
+        _replicate_groups_of(store, rep, net, pooled_params(store, rep), sd, dof, xs)
+    return np.array(sd), np.array(dof, dtype=float), np.array(xs).reshape(len(xs), len(net.input_names))
+
+
+def _replicate_groups_of(store, rep, net: QuantityNet, params, sd: list, dof: list, xs: list):
+    q = net.quantity
     if q.metric == "mu_ie_s":
         cols = list(fraction_columns(rep.metric_names))
     else:
         cols = [(rep.metric_names.index(q.metric), None)] if q.metric in rep.metric_names else []
-    sd, dof, xs = [], [], []
     for j, frac in cols:
         for p in np.unique(rep.points):
             k = (rep.points == p) & counted_runs(rep, rep.metric_names[j])
@@ -239,7 +247,6 @@ def replicate_groups(store, rep, net: QuantityNet) -> tuple[np.ndarray, np.ndarr
             sd.append(rep.values[k, j].std(ddof=1))
             dof.append(k.sum() - 1)
             xs.append(x)
-    return np.array(sd), np.array(dof, dtype=float), np.array(xs).reshape(len(xs), len(net.input_names))
 
 
 def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.ndarray) -> float:
@@ -265,10 +272,10 @@ def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.n
     return float(np.sqrt(r2))
 
 
-def test_correlation(store, net: QuantityNet, rep=None) -> float:
+def test_correlation(store, net: QuantityNet, reps=()) -> float:
     """How much one run's seed scatter at its several points (the shear fractions of one ring-
     shear run) goes together, clipped to [0, 0.95]; 0 for a quantity measured once per run. From
-    the replicate store `rep` where it has at least 5 points with 3 or more runs: the mean
+    the replicate stores `reps` where they have at least 5 points with 3 or more runs: the mean
     correlation, between two shear points, of the runs' deviations from their point's mean (each
     point's and shear point's deviations in units of their sd). Else from the store's runs: the
     mean correlation of the net's in-sample residuals at two points of one run — an upper bound,
@@ -277,9 +284,9 @@ def test_correlation(store, net: QuantityNet, rep=None) -> float:
     points = fraction_columns(store.metric_names)
     if "shear_fraction" not in net.input_names or len(points) < 2:
         return 0.0
-    if rep is not None:
+    dev = []
+    for rep in reps:
         cols = [j for j, _ in fraction_columns(rep.metric_names)]
-        dev = []
         for p in np.unique(rep.points):
             v = rep.values[(rep.points == p) & (rep.status == 1)][:, cols]
             v = v[np.all(np.isfinite(v), axis=1)]
@@ -288,9 +295,10 @@ def test_correlation(store, net: QuantityNet, rep=None) -> float:
             sd = v.std(axis=0, ddof=1)
             if np.all(sd > 0):
                 dev.append((v - v.mean(axis=0)) / sd)
-        if len(dev) >= 5:
-            c = np.corrcoef(np.vstack(dev).T)
-            return float(np.clip(c[np.triu_indices(len(cols), 1)].mean(), 0.0, 0.95))
+    dev = [v for v in dev if v.shape[1] == dev[0].shape[1]] if dev else []  # stores with the same shear points
+    if len(dev) >= 5:
+        c = np.corrcoef(np.vstack(dev).T)
+        return float(np.clip(c[np.triu_indices(dev[0].shape[1], 1)].mean(), 0.0, 0.95))
     cols = np.array([store.values[:, j] - net(np.column_stack([store.params, np.full(len(store.params), frac)]))
                      for j, frac in points]).T
     r = cols[(store.status == 1) & np.all(np.isfinite(cols), axis=1)]
@@ -303,8 +311,7 @@ def test_correlation(store, net: QuantityNet, rep=None) -> float:
 def store_hash(store, pooled=()) -> str:
     h = hashlib.sha256()
     h.update(f"nets {NET_FORMAT} bag {BAG} folds {FOLDS} sizes {SIZES} error span {ERROR_SPAN}".encode())
-    rep = replicate_store_path(store, pooled)
-    if rep is not None:
+    for rep in replicate_store_paths(store, pooled):
         h.update(rep.read_bytes())
     for st in (store, *pooled):
         h.update(st.spec.to_json().encode())
@@ -377,21 +384,18 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
     return nets
 
 
-def replicate_store(store, pooled=()):
-    """The store's replicate store, opened (replicate_store_path), or None."""
-    path = replicate_store_path(store, pooled)
-    if path is None:
-        return None
+def replicate_stores(store, pooled=()) -> list:
+    """The store's replicate stores, opened (replicate_store_paths)."""
     from ..campaign import Campaign
-    return Campaign.open(path).store
+    return [Campaign.open(p).store for p in replicate_store_paths(store, pooled)]
 
 
-def replicate_shape(store, rep, net: QuantityNet) -> tuple[float, float]:
-    """(scatter_ratio, test_correlation) of a net from the replicate store `rep` (without one:
+def replicate_shape(store, reps, net: QuantityNet) -> tuple[float, float]:
+    """(scatter_ratio, test_correlation) of a net from the replicate stores `reps` (without any:
     nan, and the correlation from the store's own runs)."""
-    if rep is None:
+    if not reps:
         return float("nan"), test_correlation(store, net)
-    return fit_scatter_ratio(net, *replicate_groups(store, rep, net)), test_correlation(store, net, rep)
+    return fit_scatter_ratio(net, *replicate_groups(store, reps, net)), test_correlation(store, net, reps)
 
 
 def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Quantity, QuantityNet]:
@@ -412,9 +416,9 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
                 if "scatter_ratio" not in str(a["meta"]):  # cached before the replicates gave the scatter's shape and correlation
                     stale.append((f, n))
             nets[n.quantity] = n
-        rep = replicate_store(store, pooled) if stale else None
+        reps = replicate_stores(store, pooled) if stale else []
         for f, n in stale:
-            n.scatter_ratio, n.test_correlation = replicate_shape(store, rep, n)
+            n.scatter_ratio, n.test_correlation = replicate_shape(store, reps, n)
             try:
                 np.savez(f, **n.to_arrays())
             except OSError:
@@ -423,14 +427,13 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
     extra = "".join(f" + {(o.status == 1).sum()} of {o.path.name}" for o in pooled)
     say(f"training surrogates for {store.path.name} ({(store.status == 1).sum()} finished runs{extra}; cached in {d})")
     nets = train(store, say, pooled)
-    rep = replicate_store(store, pooled)
-    if rep is not None:
-        for q, sd in seed_scatter(rep).items():
-            if q in nets:
-                nets[q].scatter = sd
-                say(f"  {q.key:28s} seed scatter {sd:.4g} (from {rep.path.name})")
+    reps = replicate_stores(store, pooled)
+    for q, sd in seed_scatter(reps).items():
+        if q in nets:
+            nets[q].scatter = sd
+            say(f"  {q.key:28s} seed scatter {sd:.4g} (from {', '.join(r.path.name for r in reps)})")
     for q, n in nets.items():
-        n.scatter_ratio, n.test_correlation = replicate_shape(store, rep, n)
+        n.scatter_ratio, n.test_correlation = replicate_shape(store, reps, n)
         if np.isfinite(n.scatter_ratio):
             say(f"  {q.key:28s} seed scatter {n.scatter_ratio:.2f} of the error model's sd (the replicates vary with it)")
         if n.test_correlation:

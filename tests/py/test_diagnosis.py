@@ -408,7 +408,7 @@ def test_the_specimen_correlation_comes_from_the_replicates():
         dev = rng.multivariate_normal(np.zeros(3), cov, size=120) * rng.uniform(0.02, 0.2, 30).repeat(4)[:, None]
         rep = SimpleNamespace(metric_names=names, points=np.arange(30).repeat(4), status=np.ones(120, dtype=int),
                               values=0.7 + dev)
-        c = test_correlation(store, net, rep)
+        c = test_correlation(store, net, [rep])
         assert (abs(c - 0.6) < 0.15) if rho else (c <= 0.15), (rho, c)
 
 
