@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -333,6 +334,14 @@ def cache_dir(store) -> Path:
     return store.path.with_name(store.path.name + ".nets")
 
 
+def _mark_used(stamp: Path):
+    """The slot's last use as its stamp's mtime, from the nanosecond clock: the file system's own
+    timestamp (touch) is as coarse as a kernel tick, so two loads a few ms apart tied and the
+    least recently used slot was a coin toss."""
+    now = time.time_ns()
+    os.utime(stamp, ns=(now, now))
+
+
 def _prune_slots(d: Path, keep: Path):
     """The SLOTS most recently used training sets stay; older ones and the flat layout that kept
     one set per store (until 2026-11-24) go."""
@@ -406,7 +415,7 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
     stamp = d / "store_hash.txt"
     if not retrain and stamp.exists() and stamp.read_text().strip() == key:
         try:
-            stamp.touch()  # recently used: the last set _prune_slots lets go
+            _mark_used(stamp)  # recently used: the last set _prune_slots lets go
         except OSError:
             pass  # a read-only checkout
         nets, stale = {}, []
@@ -444,5 +453,6 @@ def load_or_train(store, say=print, retrain: bool = False, pooled=()) -> dict[Qu
     for q, n in nets.items():
         np.savez(d / f"{q.metric}.npz", **n.to_arrays())
     stamp.write_text(key + "\n")
+    _mark_used(stamp)
     _prune_slots(d.parent, d)
     return nets
