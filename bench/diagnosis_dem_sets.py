@@ -116,7 +116,7 @@ def diagnose(args):
         if args.density_factor is not None:  # a discrepancy no candidate represents (synthetic.density_mismatch)
             noisy = synthetic.density_mismatch(noisy, args.density_factor)
             row = {**row, "rows": [{**r, "value": r["value"] * args.density_factor
-                                    if r["metric"] in ("bulk_density", "mass_flow_rate") and r["value"] is not None
+                                    if r["metric"] in synthetic.DENSITY_METRICS and r["value"] is not None
                                     else r["value"]} for r in row["rows"]]}
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]

@@ -209,12 +209,10 @@ def seed_scatter(reps) -> dict[Quantity, float]:
                 names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
             a = acc.setdefault(Quantity(rig, metric), [0.0, 0])
             for m in names:
-                ok = counted_runs(store, m)
-                y = store.values[ok, store.metric_names.index(m)]
-                _, inverse, counts = np.unique(store.points[ok], return_inverse=True, return_counts=True)
-                means = np.bincount(inverse, weights=y) / np.maximum(counts, 1)
-                a[0] += float(((y - means[inverse]) ** 2).sum())
-                a[1] += int((counts - 1).sum())
+                _, _, counts, sd = store.point_table(m, rows=counted_runs(store, m))
+                k = int((counts - 1).sum())
+                if k > 0 and np.isfinite(sd):
+                    a[0], a[1] = a[0] + sd * sd * k, a[1] + k
     return {q: float(np.sqrt(ss / dof)) for q, (ss, dof) in acc.items() if dof > 0}
 
 
@@ -227,27 +225,24 @@ def replicate_groups(store, reps, net: QuantityNet) -> tuple[np.ndarray, np.ndar
     q = net.quantity
     sd, dof, xs = [], [], []
     for rep in reps:
-        _replicate_groups_of(store, rep, net, pooled_params(store, rep), sd, dof, xs)
+        params = pooled_params(store, rep)
+        if q.metric == "mu_ie_s":
+            cols = list(fraction_columns(rep.metric_names))
+        else:
+            cols = [(rep.metric_names.index(q.metric), None)] if q.metric in rep.metric_names else []
+        for j, frac in cols:
+            counted = counted_runs(rep, rep.metric_names[j])
+            for p in np.unique(rep.points):
+                k = (rep.points == p) & counted
+                if k.sum() < 2:
+                    continue
+                x = params[k][0] if frac is None or "shear_fraction" not in net.input_names else np.r_[params[k][0], frac]
+                if len(x) != len(net.input_names):
+                    continue
+                sd.append(rep.values[k, j].std(ddof=1))
+                dof.append(k.sum() - 1)
+                xs.append(x)
     return np.array(sd), np.array(dof, dtype=float), np.array(xs).reshape(len(xs), len(net.input_names))
-
-
-def _replicate_groups_of(store, rep, net: QuantityNet, params, sd: list, dof: list, xs: list):
-    q = net.quantity
-    if q.metric == "mu_ie_s":
-        cols = list(fraction_columns(rep.metric_names))
-    else:
-        cols = [(rep.metric_names.index(q.metric), None)] if q.metric in rep.metric_names else []
-    for j, frac in cols:
-        for p in np.unique(rep.points):
-            k = (rep.points == p) & counted_runs(rep, rep.metric_names[j])
-            if k.sum() < 2:
-                continue
-            x = params[k][0] if frac is None or "shear_fraction" not in net.input_names else np.r_[params[k][0], frac]
-            if len(x) != len(net.input_names):
-                continue
-            sd.append(rep.values[k, j].std(ddof=1))
-            dof.append(k.sum() - 1)
-            xs.append(x)
 
 
 def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.ndarray) -> float:

@@ -292,12 +292,15 @@ def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str)
     Path(path).write_text("\n".join(lines) + "\n")
 
 
+DENSITY_METRICS = ("bulk_density", "mass_flow_rate")  # the quantities that scale with the solid density
+
+
 def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]:
     """A discrepancy that no candidate represents: the solid density is `factor` times what the
     model assumes, which scales every bulk density and mass flow rate and nothing else."""
     out = []
     for o in obs:
-        k = factor if o.quantity.metric in ("bulk_density", "mass_flow_rate") else 1.0
+        k = factor if o.quantity.metric in DENSITY_METRICS else 1.0
         out.append(Observation(o.quantity, dict(o.conditions), o.value * k, o.uncertainty * k, o.label))
     return out
 

@@ -138,20 +138,26 @@ class CampaignStore:
     def counts(self) -> dict[str, int]:
         return {name: int((self.status == s).sum()) for s, name in STATUS_NAMES.items()}
 
-    def table(self, metric: str, only_done: bool = True):
-        """(inputs, values, uncertainties) of one metric over the finished runs with a finite value."""
+    def _metric_index(self, metric: str) -> int:
         if metric not in self.metric_names:
             raise StoreError(f"{self.path}: no metric {metric!r} (has: {', '.join(self.metric_names) or 'none yet'})")
-        j = self.metric_names.index(metric)
+        return self.metric_names.index(metric)
+
+    def table(self, metric: str, only_done: bool = True):
+        """(inputs, values, uncertainties) of one metric over the finished runs with a finite value."""
+        j = self._metric_index(metric)
         ok = np.isfinite(self.values[:, j]) & ((self.status == DONE) if only_done else True)
         return self.params[ok], self.values[ok, j], self.uncertainty[ok, j]
 
-    def point_table(self, metric: str):
+    def point_table(self, metric: str, rows: np.ndarray | None = None):
         """One metric per design point: (inputs, mean over the point's finished replicates,
-        replicate count, pooled replicate standard deviation of one run (nan without replicates))."""
-        x_runs, y_runs, _ = self.table(metric)
-        j = self.metric_names.index(metric)
+        replicate count, pooled replicate standard deviation of one run (nan without replicates)).
+        rows: a (runs,) mask of the runs that count besides (default: every finished one)."""
+        j = self._metric_index(metric)
         ok = np.isfinite(self.values[:, j]) & (self.status == DONE)
+        if rows is not None:
+            ok &= rows
+        x_runs, y_runs = self.params[ok], self.values[ok, j]
         pts = self.points[ok]
         uniq, inverse, counts = np.unique(pts, return_inverse=True, return_counts=True)
         means = np.bincount(inverse, weights=y_runs) / counts
