@@ -15,7 +15,8 @@ beside the physics baselines.
   from the empty end);
 - baselines: Beverloo's slot law for a case's discharge time (C and k fitted on training cases
   only) and, per frame, the remaining time as the frame's fill fraction times it; a constant-rate
-  extrapolation of the first 20 % of NRRP(t)."""
+  extrapolation of the first 20 % of NRRP(t), and the NRRP as a fill-level gauge calibrated on
+  training cases reads it."""
 from __future__ import annotations
 
 import contextlib
@@ -264,6 +265,14 @@ def fill_fraction(x: np.ndarray, first: np.ndarray) -> np.ndarray:
     frame: an image-only estimate of the NRRP."""
     dark = lambda f: np.sum(f < 0.9 * np.median(f), axis=(-2, -1)).reshape(len(f))  # noqa: E731
     return dark(x) / max(float(dark(first[None])[0]), 1.0)
+
+
+def fill_level_nrrp(fill_train: np.ndarray, nrrp_train: np.ndarray, fill: np.ndarray, degree: int = 3) -> np.ndarray:
+    """The NRRP a fill-level gauge reads: a polynomial (degree 3) of the frame's fill fraction
+    fitted to training cases' whole discharges, clipped to [0, 1] — what the image's fill level
+    alone carries about the count that remains, once calibrated on other hoppers."""
+    coeffs = np.polyfit(np.asarray(fill_train, float), np.asarray(nrrp_train, float), degree)
+    return np.clip(np.polyval(coeffs, np.asarray(fill, float)), 0.0, 1.0)
 
 
 def constant_rate_nrrp(t: np.ndarray, nrrp: np.ndarray, fraction: float = 0.2) -> np.ndarray:

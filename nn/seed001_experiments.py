@@ -12,7 +12,9 @@
 
 Baselines: the remaining discharge time as the frame's fill fraction (image-only NRRP
 estimate) times Beverloo's discharge time (C, k fitted on the training cases); NRRP by a
-constant-rate extrapolation of the first 20 %. Every result records its settings, the time each
+constant-rate extrapolation of the first 20 %, and (pretrained protocol) a fill-level gauge: NRRP
+as a cubic of the frame's fill fraction, fitted on the pretraining cases of the same packing.
+Every result records its settings, the time each
 training took and the machine, so the docs' tables can say what stands behind them."""
 from __future__ import annotations
 
@@ -192,6 +194,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     cases = FrameStore(store).cases()
     data = {c: images.load_frames(store, cases=[c], size=size) for c in cases}
     folds = sorted({_fold(c) for c in cases})
+    fills = {c: images.fill_fraction(data[c].x, data[c].x[0]) for c in cases}
     pretrained = {}
     if protocol == "pretrained":
         if len(folds) < 3:
@@ -199,7 +202,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         whole = {c: _nrrp_windows(data[c], window, stride) for c in cases if len(data[c].x) >= window}
         for i, fold in enumerate(folds):
             val_fold = folds[(i + 1) % len(folds)]
-            tr = [w for c, w in whole.items() if _fold(c) not in (fold, val_fold)]
+            tr = [w for c, w in whole.items() if _fold(c) in pretraining_folds(fold, folds)]
             va = [w for c, w in whole.items() if _fold(c) == val_fold]
             xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
             xv, yv = np.concatenate([a for a, _ in va]), np.concatenate([b for _, b in va])
@@ -213,7 +216,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             pretrained[fold] = (model, scaling, time.perf_counter() - t0)
     for case in cases:
         f = data[case]
-        k = max(window + 2, int(round(fraction * len(f.x))))
+        k = first_part(len(f.x), fraction, window)
         if len(f.x) < k + window:
             say(f"  {case}: {len(f.x)} frames, too few for windows of {window}; skipped")
             continue
@@ -244,16 +247,45 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         base = images.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
         row |= {"net": images.scores(truth, pred), "baseline": images.scores(truth, base), "time": f.time[k:].tolist(),
                 "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": base.tolist()}
+        if protocol == "pretrained":
+            gauge = fill_level_baseline(case, fills, data, folds, k)
+            if gauge is not None:
+                row |= {"fill_level": images.scores(truth, gauge), "fill_level_nrrp": gauge.tolist()}
         res["cases"][case] = row
         say(f"  {case}: relative error {row['net']['relative_error']:.3f} "
             + (f"(zero-shot {row['zero_shot']['relative_error']:.3f}) " if "zero_shot" in row else "")
-            + f"(constant rate {row['baseline']['relative_error']:.3f})")
-    keys = ("net", "baseline") + (("zero_shot",) if protocol == "pretrained" else ())
-    res["per_packing"] = {pk: {key: float(np.mean([r[key]["relative_error"] for c, r in res["cases"].items()
-                                                   if _packing(c) == pk])) for key in keys}
+            + f"(constant rate {row['baseline']['relative_error']:.3f}"
+            + (f", fill-level gauge {row['fill_level']['relative_error']:.3f}" if "fill_level" in row else "") + ")")
+    keys = ("net", "baseline") + (("zero_shot", "fill_level") if protocol == "pretrained" else ())
+    res["per_packing"] = {pk: {key: float(np.mean(errs)) for key in keys
+                               if (errs := [r[key]["relative_error"] for c, r in res["cases"].items()
+                                            if _packing(c) == pk and key in r])}
                           for pk in PACKINGS if any(_packing(c) == pk for c in res["cases"])}
     _save(out / "process.json", res)
     return res
+
+
+def first_part(frames: int, fraction: float, window: int) -> int:
+    """How many of a case's first frames the process experiment trains on (the rest it predicts)."""
+    return max(window + 2, int(round(fraction * frames)))
+
+
+def pretraining_folds(fold: str, folds: list[str]) -> list[str]:
+    """The folds a case's network pretrains on (the pretrained protocol): all but the case's own
+    and the next one, which validates."""
+    i = folds.index(fold)
+    return [f for f in folds if f not in (fold, folds[(i + 1) % len(folds)])]
+
+
+def fill_level_baseline(case: str, fills: dict, data: dict, folds: list[str], k: int) -> np.ndarray | None:
+    """The case's NRRP from frame k on as a fill-level gauge reads it, calibrated on the whole
+    discharges of the cases of its packing that its network pretrains on (images.fill_level_nrrp):
+    the same cases, the same frames, no learning beyond a cubic. None without such cases."""
+    train = [c for c in fills if _packing(c) == _packing(case) and _fold(c) in pretraining_folds(_fold(case), folds)]
+    if not train:
+        return None
+    return images.fill_level_nrrp(np.concatenate([fills[c] for c in train]),
+                                  np.concatenate([data[c].nrrp for c in train]), fills[case][k:])
 
 
 def _save(path: Path, res: dict):

@@ -86,6 +86,16 @@ def test_constant_rate_baseline_on_a_steady_discharge():
     assert np.allclose(images.constant_rate_nrrp(t, nrrp), nrrp, atol=1e-12)
 
 
+def test_fill_level_gauge_recovers_a_cubic_reading_and_stays_in_0_1():
+    # the count remaining as a known cubic of the fill level (calibration discharges), read at new
+    # fill levels: exact to round-off; beyond the calibration, clipped to [0, 1]
+    fill = np.linspace(0.2, 1.0, 50)
+    law = lambda f: 0.1 + 0.3 * f + 0.8 * f ** 2 - 0.2 * f ** 3  # noqa: E731
+    new = np.array([0.35, 0.5, 0.77])
+    assert np.allclose(images.fill_level_nrrp(fill, law(fill), new), law(new), atol=1e-12)
+    assert images.fill_level_nrrp(fill, law(fill), np.array([3.0, 5.0])).tolist() == [1.0, 0.0]  # 2.8, -3.4
+
+
 def test_beverloo_baseline_recovers_its_law():
     from pydem.rigs.hopper import TABLE1
     c_true, k_true = 0.58, 1.4

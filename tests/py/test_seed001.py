@@ -61,7 +61,9 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, say=lambda *a: None)
     assert set(proc["per_packing"]) == {"A", "B1", "B2", "B3", "B4"}
     assert proc["settings"]["protocol"] == "pretrained"
-    assert all(set(v) == {"net", "baseline", "zero_shot"} for v in proc["per_packing"].values())
+    assert all(set(v) == {"net", "baseline", "zero_shot", "fill_level"} for v in proc["per_packing"].values())
+    # the gauge is calibrated on the cases the network pretrains on: for fold 1, folds 3, 4, 5
+    assert ex.pretraining_folds("1", ["1", "2", "3", "4", "5"]) == ["3", "4", "5"]
     assert all(isinstance(r["finetune_kept"], bool) for r in proc["cases"].values())
     page = write(SUBSET, tmp_path, tmp_path / "report")
     text = page.read_text()
