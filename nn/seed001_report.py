@@ -109,10 +109,11 @@ def process_section(res: dict, plots: dict):
     from pydem.calibration.report import _png, _table
     import matplotlib.pyplot as plt
     zero = any("zero_shot" in v for v in res["per_packing"].values())
+    gauge = all("fill_level" in v for v in res["per_packing"].values())  # runs before 2026-11-28 lack it
     rows = [[pk, _f(v["net"])] + ([_f(v["zero_shot"])] if zero else []) + [_f(v["baseline"])]
-            for pk, v in res["per_packing"].items()]
+            + ([_f(v["fill_level"])] if gauge else []) for pk, v in res["per_packing"].items()]
     md, h = _table(rows, ["packing", "CNN-LSTM relative error"] + (["zero-shot (no frame of the case)"] if zero else [])
-                   + ["constant-rate relative error"])
+                   + ["constant-rate relative error"] + (["fill-level gauge relative error"] if gauge else []))
     fig, axes = plt.subplots(1, 5, figsize=(13, 2.8), sharey=True)
     for ax, pk in zip(axes, ("A", "B1", "B2", "B3", "B4")):
         cases = [c for c in res["cases"] if c.split("-")[0] == pk]
@@ -122,6 +123,8 @@ def process_section(res: dict, plots: dict):
         ax.plot(r["time"], r["nrrp"], "k-", label="DEM")
         ax.plot(r["time"], r["predicted"], "C0--", label="CNN-LSTM")
         ax.plot(r["time"], r["baseline_nrrp"], "C1:", label="constant rate")
+        if "fill_level_nrrp" in r:
+            ax.plot(r["time"], r["fill_level_nrrp"], "C2-.", label="fill-level gauge")
         ax.set_title(cases[0], fontsize=9)
         ax.set_xlabel("t (s)")
     axes[0].set_ylabel("NRRP")
