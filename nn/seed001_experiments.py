@@ -194,14 +194,14 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     cases = FrameStore(store).cases()
     data = {c: images.load_frames(store, cases=[c], size=size) for c in cases}
     folds = sorted({_fold(c) for c in cases})
-    fills = {c: images.fill_fraction(data[c].x, data[c].x[0]) for c in cases}
-    pretrained = {}
+    pretrained, fills = {}, {}
     if protocol == "pretrained":
         if len(folds) < 3:
             raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
         whole = {c: _nrrp_windows(data[c], window, stride) for c in cases if len(data[c].x) >= window}
-        for i, fold in enumerate(folds):
-            val_fold = folds[(i + 1) % len(folds)]
+        fills = {c: images.fill_fraction(data[c].x, data[c].x[0]) for c in cases}  # the fill-level gauge's input
+        for fold in folds:
+            val_fold = validation_fold(fold, folds)
             tr = [w for c, w in whole.items() if _fold(c) in pretraining_folds(fold, folds)]
             va = [w for c, w in whole.items() if _fold(c) == val_fold]
             xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
@@ -270,11 +270,15 @@ def first_part(frames: int, fraction: float, window: int) -> int:
     return max(window + 2, int(round(fraction * frames)))
 
 
+def validation_fold(fold: str, folds: list[str]) -> str:
+    """The fold that validates the pretraining for a fold's cases: the next one."""
+    return folds[(folds.index(fold) + 1) % len(folds)]
+
+
 def pretraining_folds(fold: str, folds: list[str]) -> list[str]:
     """The folds a case's network pretrains on (the pretrained protocol): all but the case's own
-    and the next one, which validates."""
-    i = folds.index(fold)
-    return [f for f in folds if f not in (fold, folds[(i + 1) % len(folds)])]
+    and its validation fold."""
+    return [f for f in folds if f not in (fold, validation_fold(fold, folds))]
 
 
 def fill_level_baseline(case: str, fills: dict, data: dict, folds: list[str], k: int) -> np.ndarray | None:
