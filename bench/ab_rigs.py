@@ -30,13 +30,13 @@ if not pydem.__file__.startswith(os.getcwd() + os.sep):
     raise SystemExit(f"pydem imported from {pydem.__file__}, not from {os.getcwd()}")
 from pydem.rigs import RIGS
 from pydem.rigs.config import set_value
-rig, preset, seed = sys.argv[1], sys.argv[2], int(sys.argv[3])
+rig, preset, seed, threads = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
 cls, cfg_cls = RIGS[rig]
 cfg = cfg_cls.preset(preset)
-for item in sys.argv[4:]:
+for item in sys.argv[5:]:
     key, value = item.split("=", 1)
     set_value(cfg, key, value)
-cfg.num_threads = 1
+cfg.num_threads = threads
 t0, c0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_SELF).ru_utime
 res = cls(cfg).run(seed=seed)
 metrics = {k: getattr(m, "value", m) for k, m in res.metrics.items()}
@@ -60,7 +60,7 @@ def start(checkout: Path, args) -> subprocess.Popen:
     # `python -c` puts the working directory first on sys.path: run in the checkout, so that its
     # pydem is the one imported (an editable install or PYTHONPATH alone would not decide it)
     env = dict(os.environ, PYTHONPATH=str(checkout), OMP_NUM_THREADS="1")
-    cmd = [sys.executable, "-c", RUN, args.rig, args.preset, str(args.seed), *args.set]
+    cmd = [sys.executable, "-c", RUN, args.rig, args.preset, str(args.seed), "1", *args.set]
     return subprocess.Popen(cmd, env=env, cwd=checkout, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

@@ -90,6 +90,7 @@ dem_status dem_domain_create(const dem_domain_def *def, dem_domain **out, char *
     d->rayleigh_cache = -1.0;
     d->need_rebuild = 1;
     d->single_material = -1;
+    dem_governor_reset(&d->gov, d->def.num_threads, 1);
     *out = d;
     return DEM_OK;
 }
@@ -180,6 +181,17 @@ dem_status dem_domain_set_num_threads(dem_domain *d, int num_threads)
         return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_domain_set_num_threads: must be in [1, 1024], got %d",
                         num_threads);
     d->def.num_threads = num_threads;
+    dem_governor_reset(&d->gov, num_threads, d->gov.adaptive);
+    dem_clear_error(d);
+    return DEM_OK;
+}
+
+dem_status dem_domain_set_adaptive_threads(dem_domain *d, int adaptive)
+{
+    if (!d) return DEM_ERR_NULL;
+    if (adaptive != 0 && adaptive != 1)
+        return dem_fail(d, DEM_ERR_INVALID_ARGUMENT, "dem_domain_set_adaptive_threads: must be 0 or 1, got %d", adaptive);
+    dem_governor_reset(&d->gov, d->def.num_threads, adaptive);
     dem_clear_error(d);
     return DEM_OK;
 }

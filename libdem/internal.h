@@ -4,6 +4,7 @@
 
 #include "dem/dem.h"
 #include "alloc.h"
+#include "thread_governor.h"
 #include <math.h>
 #include <stdarg.h>
 
@@ -140,6 +141,7 @@ struct dem_domain {
     int64_t split[DEM_SPLIT_MAX + 1];
     double split_busy[DEM_SPLIT_MAX];
     int split_threads;
+    dem_governor gov;         /* how many threads the steps use now (thread_governor.c) */
     int64_t trans_capacity;   /* entries the slot and trans_entry arrays can hold */
     int32_t *cell_of;         /* n */
     int64_t *cell_start;      /* n_cells + 1 */
@@ -164,6 +166,9 @@ struct dem_domain {
     int forces_valid;         /* f/t belong to the current state */
 };
 
+
+/* the threads of the next parallel region of a step (<= def.num_threads; thread_governor.c) */
+static inline int dem_team(const dem_domain *d) { return d->gov.team; }
 
 /* error reporting: sets the message, returns status */
 dem_status dem_fail(dem_domain *d, dem_status s, const char *fmt, ...)

@@ -361,7 +361,7 @@ static void reorder_particles(dem_domain *d, int64_t n)
  * old list (the buffers stay with the domain: a build at a size seen before allocates nothing). */
 static dem_status build_pair_list(dem_domain *d, int64_t n)
 {
-    const int nt = d->def.num_threads;
+    const int nt = dem_team(d);
     pair_list *pl = &d->pairs_cur;
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;

@@ -97,7 +97,7 @@ static sweep_result open_first_step(dem_domain *d)
     const int64_t n = d->n;
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX;
-#pragma omp parallel for schedule(static) num_threads(d->def.num_threads) reduction(max : maxdisp2) \
+#pragma omp parallel for schedule(static) num_threads(dem_team(d)) reduction(max : maxdisp2) \
     reduction(min : bad_nan, bad_out)
     for (int64_t i = 0; i < n; i++) {
         sweep_result res;
@@ -186,8 +186,11 @@ dem_status dem_domain_step(dem_domain *d, int64_t n_steps)
         double t2 = now_s();
         d->profile.neighbor_s += t2 - t1;
         /* forces, closing half kick and (but for the last step) the next opening half kick + drift */
+        if (dem_team(d) < d->def.num_threads) d->profile.steps_fewer_threads++;
         m = dem_sweep(d, dt, s + 1 < n_steps ? SWEEP_CLOSE_OPEN : SWEEP_CLOSE);
-        d->profile.contact_s += now_s() - t2;
+        const double t3 = now_s();
+        d->profile.contact_s += t3 - t2;
+        dem_governor_record(&d->gov, d->def.num_threads, t3 - t2);
         if (m.bad_pair != INT64_MAX || m.bad_wall != INT64_MAX) {
             d->forces_valid = 0;
             return m.bad_pair != INT64_MAX ? dem_report_runaway_pair(d, m.bad_pair)

@@ -3,16 +3,18 @@
     import pydem
     dom = pydem.Domain(lo=(0, 0, 0), hi=(0.1, 0.1, 0.1))
 """
-__version__ = "0.2.0"
+__version__ = "0.2.1"
 
 import os as _os
 
-# OpenMP threads sleep at once at a barrier instead of spinning first: beside other processes a
-# 2-thread run then keeps the 1-thread speed (1.03x instead of 0.45x), at ~10 % on a quiet
-# machine (bench/README.md, "A busy machine"). Set before libdem loads libgomp; an explicit
-# OMP_WAIT_POLICY or GOMP_SPINCOUNT of the user wins.
+# OpenMP threads spin briefly (10^4 rounds, microseconds) at a barrier, then sleep. Sleeping at
+# once (OMP_WAIT_POLICY=passive) made a small rig run on 2 threads slower than on 1 (hopper
+# `default`: 8.0 s against 5.5 s; with the short spin 3.5 s); spinning long made a 2-thread run
+# beside a busy process 2x slower than 1 thread. The busy machine is now libdem's thread
+# governor's job (it drops to fewer threads while they measure faster; bench/README.md, "A busy
+# machine"). Set before libdem loads libgomp; an explicit OMP_WAIT_POLICY or GOMP_SPINCOUNT wins.
 if "OMP_WAIT_POLICY" not in _os.environ and "GOMP_SPINCOUNT" not in _os.environ:
-    _os.environ["OMP_WAIT_POLICY"] = "passive"
+    _os.environ["GOMP_SPINCOUNT"] = "10000"
 
 try:
     from ._libdem import ffi as _ffi, lib as _lib

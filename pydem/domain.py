@@ -139,6 +139,11 @@ class Domain:
     def num_threads(self, value: int):
         self._check(lib.dem_domain_set_num_threads(self._d, int(value)))
 
+    def set_adaptive_threads(self, adaptive: bool):
+        """True (the default): the steps use fewer than num_threads threads while that measures
+        faster (a busy machine, a small system); results do not depend on it."""
+        self._check(lib.dem_domain_set_adaptive_threads(self._d, int(bool(adaptive))))
+
     def set_gravity(self, g: Sequence[float]):
         self._check(lib.dem_domain_set_gravity(self._d, ffi.new("double[3]", list(g))))
 
@@ -307,7 +312,7 @@ class Domain:
         p = ffi.new("dem_profile *")
         self._check(lib.dem_domain_profile(self._d, p))
         return {k: getattr(p, k) for k in ("neighbor_s", "contact_s", "integrate_s", "steps", "neighbor_builds",
-                                           "neighbor_pairs")}
+                                           "neighbor_pairs", "steps_fewer_threads")}
 
     def state_hash(self) -> int:
         h = ffi.new("uint64_t *")

@@ -8,8 +8,8 @@
 
 #define DEM_VERSION_MAJOR 0
 #define DEM_VERSION_MINOR 2
-#define DEM_VERSION_PATCH 0
-#define DEM_VERSION_STRING "0.2.0"
+#define DEM_VERSION_PATCH 1
+#define DEM_VERSION_STRING "0.2.1"
 
 #if defined(_WIN32) && defined(DEM_BUILD_SHARED)
 #define DEM_API __declspec(dllexport)

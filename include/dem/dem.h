@@ -32,6 +32,10 @@ DEM_API dem_status dem_domain_get_def(const dem_domain *domain, dem_domain_def *
 DEM_API dem_status dem_domain_set_dt(dem_domain *domain, double dt);
 DEM_API dem_status dem_domain_set_gravity(dem_domain *domain, const double gravity[3]);
 DEM_API dem_status dem_domain_set_num_threads(dem_domain *domain, int num_threads);
+/* 1 (the default): the steps use fewer than num_threads threads while that measures faster —
+ * a machine whose other processes take cores, or a system too small for the team; the choice
+ * is re-measured every 0.25-8 s of stepping. 0: always num_threads. Results do not depend on it. */
+DEM_API dem_status dem_domain_set_adaptive_threads(dem_domain *domain, int adaptive);
 
 /* Advances n_steps steps of velocity Verlet. Returns DEM_WARN_TIMESTEP_LARGE when
  * dt > 0.2 Rayleigh time (steps anyway), DEM_ERR_UNSTABLE_TIMESTEP when dt exceeds the

@@ -112,6 +112,7 @@ typedef struct dem_profile {
     int64_t steps;
     int64_t neighbor_builds;
     int64_t neighbor_pairs;  /* entries of the current (half) Verlet list */
+    int64_t steps_fewer_threads; /* steps run on fewer threads than num_threads (dem_domain_set_adaptive_threads) */
 } dem_profile;
 
 /* Time-step estimates for the current particles and materials. */

@@ -129,6 +129,9 @@ static void test_misuse_leaves_domain_usable(void **st)
     assert_status(dem_domain_step(d, -1), DEM_ERR_INVALID_ARGUMENT);
     assert_status(dem_domain_set_dt(d, -1e-6), DEM_ERR_INVALID_ARGUMENT);
     assert_status(dem_domain_set_num_threads(d, 0), DEM_ERR_INVALID_ARGUMENT);
+    assert_status(dem_domain_set_adaptive_threads(d, 2), DEM_ERR_INVALID_ARGUMENT);
+    assert_ok(dem_domain_set_adaptive_threads(d, 0));
+    assert_ok(dem_domain_set_adaptive_threads(d, 1));
     assert_status(dem_domain_step(NULL, 1), DEM_ERR_NULL);
 
     /* still usable */

@@ -1,17 +1,19 @@
 /* Results are bitwise identical for any thread count (fixed-order force reduction):
  * a settling polydisperse bed with walls, friction and EPSD2 rolling resistance, and a
  * periodic variant, run with 1, 2 and 3 threads, must give the same state hash; so must
- * one long step call and the same steps split into several calls. */
+ * one long step call and the same steps split into several calls, and a run whose thread
+ * count changes between calls (as the thread governor changes it between steps). */
 #include "test_util.h"
 
-static uint64_t run_bed(int threads, int periodic_x, int chunks)
+/* chunks calls of 3000 / chunks steps; call c runs on threads[c % n_threads] threads */
+static uint64_t run_bed_varying(const int *threads, int n_threads, int periodic_x, int chunks)
 {
     dem_domain_def def = dem_default_domain_def();
     def.lo[0] = def.lo[1] = def.lo[2] = 0;
     def.hi[0] = def.hi[1] = 0.02;
     def.hi[2] = 0.06;
     def.periodic[0] = periodic_x;
-    def.num_threads = threads;
+    def.num_threads = threads[0];
     def.dt = 1e-5;
     dem_domain *d;
     assert_int_equal(dem_domain_create(&def, &d, NULL, 0), DEM_OK);
@@ -47,7 +49,10 @@ static uint64_t run_bed(int threads, int periodic_x, int chunks)
     assert_ok(dem_particles_add(d, N, pos, rad, mats, vel, NULL, NULL));
     uint64_t h0, h;
     assert_ok(dem_domain_state_hash(d, &h0));
-    for (int c = 0; c < chunks; c++) assert_ok(dem_domain_step(d, 3000 / chunks));
+    for (int c = 0; c < chunks; c++) {
+        assert_ok(dem_domain_set_num_threads(d, threads[c % n_threads]));
+        assert_ok(dem_domain_step(d, 3000 / chunks));
+    }
     assert_ok(dem_domain_state_hash(d, &h));
     assert_true(h != h0);
     dem_profile prof;
@@ -57,6 +62,11 @@ static uint64_t run_bed(int threads, int periodic_x, int chunks)
     return h;
 }
 
+static uint64_t run_bed(int threads, int periodic_x, int chunks)
+{
+    return run_bed_varying(&threads, 1, periodic_x, chunks);
+}
+
 static void test_threads_walls(void **st)
 {
     (void)st;
@@ -64,6 +74,8 @@ static void test_threads_walls(void **st)
     assert_true(h1 == h2);
     assert_true(h1 == h3);
     assert_true(h1 == run_bed(2, 0, 3)); /* 3 x 1000 steps == 3000 steps */
+    const int changing[] = {2, 1, 3, 2, 1, 2};
+    assert_true(h1 == run_bed_varying(changing, 6, 0, 12)); /* 2 -> 1 -> 3 -> 2 ... threads */
 }
 
 static void test_threads_periodic(void **st)
