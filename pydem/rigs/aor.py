@@ -41,7 +41,7 @@ class AorConfig:
     lift_speed: float = knob(0.01, 1e-4, 1.0, "m/s", "cylinder lifting speed (slow: at 0.05 m/s the column collapses, docs/rigs.md)")
     rest_energy: float = knob(1e-5, 1e-9, 1.0, "", "at rest when translational kinetic energy per sphere < this x m g d")
     max_time: float = knob(10.0, 0.05, 600.0, "s", "simulated time limit")
-    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
+    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads, at most (default: OMP_NUM_THREADS, else the cores)")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between PNG frames (with --frames)")
     params: Params = field(default_factory=Params)
 

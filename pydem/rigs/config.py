@@ -12,15 +12,16 @@ from typing import Any
 
 def default_threads() -> int:
     """OpenMP threads of a rig run unless its config says otherwise: OMP_NUM_THREADS when set
-    (users and batch systems set it for a shared machine), else 1. One thread by default: on a
-    busy 2-core machine a 2-thread run waits on the descheduled thread (a tiny angle-of-repose
-    run took 141 s on 2 threads against 5.8 s on 1), and campaigns run several 1-thread runs
-    side by side; ask for 2 with --set num_threads=2 on an idle machine."""
+    (users and batch systems set it), else the cores this process may use. libdem's thread
+    governor runs the steps on fewer threads while that measures faster — a busy machine, a
+    system too small for the team — so asking for every core no longer costs: a 2-thread run
+    beside a busy process takes about its 1-thread time (bench/README.md, "Threads that measure
+    themselves"). Campaigns run one thread per run, several runs side by side."""
     text = os.environ.get("OMP_NUM_THREADS", "").split(",")[0].strip()
     try:
         return max(1, int(text))
     except ValueError:
-        return 1
+        return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
 
 
 class ConfigError(ValueError):

@@ -59,7 +59,7 @@ class HopperConfig:
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")
     max_overlap_ratio: float = knob(0.3, 0.05, 0.9, "", "overlap / smaller radius that stops the run as a blow-up "
                                     "(Table 1 cases: 0.6, see apply_case)")
-    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
+    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads, at most (default: OMP_NUM_THREADS, else the cores)")
     frame_interval: float = knob(0.05, 1e-4, 10.0, "s", "time between frames (with --frames)")
     frame_width: int = knob(420, 16, 8192, "px", "frame width")
     frame_height: int = knob(230, 16, 8192, "px", "frame height")

@@ -54,7 +54,7 @@ class RingShearConfig:
     steady_tolerance: float = knob(0.05, 1e-4, 1.0, "", "steady flow: relative change between the last quarters")
     servo_speed: float = knob(0.02, 1e-5, 1.0, "m/s", "lid servo speed limit")
     max_overlap_ratio: float = knob(0.9, 0.05, 0.9, "", "overlap / smaller radius that stops the run as a blow-up (see below)")
-    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads (default: OMP_NUM_THREADS, else 1)")
+    num_threads: int = knob(default_threads(), 1, 256, "", "OpenMP threads, at most (default: OMP_NUM_THREADS, else the cores)")
     frame_interval: float = knob(0.1, 1e-4, 10.0, "s", "time between frames (with --frames)")
     params: Params = field(default_factory=Params)
 
