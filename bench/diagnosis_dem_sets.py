@@ -11,6 +11,7 @@ diagnosis on the given stores.
     .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl --kinds null \
         --density-factor 1.25 --out bench/results/dem_sets_default.density125.diagnosed.json
     .venv/bin/python bench/diagnosis_dem_sets.py rerun --rig aor --journal bench/results/dem_sets_default.jsonl
+    .venv/bin/python bench/diagnosis_dem_sets.py summary      (every bench/results/dem_sets_default*.diagnosed.json)
 """
 from __future__ import annotations
 
@@ -148,6 +149,35 @@ def error_fall_text(sets: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def summary(args):
+    """Top-1 per kind, false alarms, the error fall and the density-mismatch verdicts over every
+    diagnosed journal matching the pattern (the density-mismatch files counted apart)."""
+    files = sorted(Path(ROOT / "bench" / "results").glob(args.pattern))
+    plain = [f for f in files if ".density" not in f.name]
+    sets = [s for f in plain for s in json.loads(f.read_text())]
+    print(f"{len(sets)} sets in {len(plain)} files")
+    for kind in sorted({s["kind"] for s in sets}):
+        mine = [s for s in sets if s["kind"] == kind]
+        verdicts = {v: sum(s["verdict"] == v for s in mine) for v in ("no_effect_needed", "effect", "indistinguishable", "unexplained")}
+        if kind == "null":
+            print(f"null: clean {verdicts['no_effect_needed']}/{len(mine)}, an effect named {verdicts['effect']}, "
+                  f"indistinguishable {verdicts['indistinguishable']}, unexplained {verdicts['unexplained']}")
+            continue
+        hit = sum(s["verdict"] == "effect" and s["effect"] == kind for s in mine)
+        wrong = sum(s["verdict"] == "effect" and s["effect"] != kind for s in mine)
+        print(f"{kind}: top-1 {hit}/{len(mine)}; no effect needed {verdicts['no_effect_needed']}, another effect {wrong}, "
+              f"indistinguishable {verdicts['indistinguishable']}, unexplained {verdicts['unexplained']}")
+    named = [s for s in sets if s["kind"] != "null" and s["verdict"] == "effect" and s["effect"] == s["kind"]
+             and s.get("error_after") is not None]
+    clean = [s["error_clean_after"] / s["error_clean_before"] for s in named if s["error_clean_before"] > 0]
+    if named:
+        print(f"error after/before against the rigs over {len(named)} named: median {np.median(clean):.2f} with the "
+              f"seed scatter taken out ({len(clean)} sets), {np.median([s['error_after'] / s['error_before'] for s in named]):.2f} raw")
+    dens = [s for f in files if ".density" in f.name for s in json.loads(f.read_text())]
+    if dens:
+        print(f"density mismatch on the nulls: unexplained {sum(s['verdict'] == 'unexplained' for s in dens)}/{len(dens)}")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -168,8 +198,10 @@ def main() -> int:
     e.add_argument("--journal", required=True)
     e.add_argument("--rig", required=True)
     e.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
+    m = sub.add_parser("summary", help="the figures over every diagnosed journal")
+    m.add_argument("--pattern", default="dem_sets_default*.diagnosed.json", help="files in bench/results")
     args = ap.parse_args()
-    {"run": run, "diagnose": diagnose, "rerun": rerun}[args.cmd](args)
+    {"run": run, "diagnose": diagnose, "rerun": rerun, "summary": summary}[args.cmd](args)
     return 0
 
 
