@@ -56,6 +56,19 @@ def commit_of(checkout: Path) -> str:
         return "no git"
 
 
+def header(what: str, old: Path, new: Path) -> str:
+    """The first line of a results file: when, which machine, what ran, which two checkouts."""
+    return (f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()}, {len(os.sched_getaffinity(0))} cores: "
+            f"{what}; old {old} ({commit_of(old)}), new {new} ({commit_of(new)})")
+
+
+def save(lines: list[str], out: Path | None):
+    """Append the lines to `out` (results accumulate across invocations)."""
+    if out:
+        with open(out, "a") as fh:
+            fh.write("\n".join(lines) + "\n")
+
+
 def start(checkout: Path, args) -> subprocess.Popen:
     # `python -c` puts the working directory first on sys.path: run in the checkout, so that its
     # pydem is the one imported (an editable install or PYTHONPATH alone would not decide it)
@@ -86,9 +99,7 @@ def main() -> int:
     for c in (args.old, args.new):
         if not (c / "pydem").is_dir():
             raise SystemExit(f"{c}: no pydem checkout there")
-    lines = [f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()}, {len(os.sched_getaffinity(0))} cores: "
-             f"{args.rig} {args.preset} seed {args.seed} {' '.join(args.set)}; old {args.old} ({commit_of(args.old)}), "
-             f"new {args.new} ({commit_of(args.new)})"]
+    lines = [header(f"{args.rig} {args.preset} seed {args.seed} {' '.join(args.set)}", args.old, args.new)]
     print(lines[0], flush=True)
     ratios = []
     for r in range(args.rounds):
@@ -108,9 +119,7 @@ def main() -> int:
     lines.append(f"geometric-mean speed-up (old CPU / new CPU) {math.exp(sum(map(math.log, ratios)) / len(ratios)):.3f} "
                  f"over {len(ratios)} rounds")
     print(lines[-1])
-    if args.out:
-        with open(args.out, "a") as fh:
-            fh.write("\n".join(lines) + "\n")
+    save(lines, args.out)
     return 0
 
 

@@ -17,15 +17,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ab_rigs import RUN, commit_of  # noqa: E402
+from ab_rigs import RUN, header, save  # noqa: E402
 
 CENTRE = ["friction=0.5", "rolling_friction=0.3", "restitution=0.55"]
 
@@ -56,9 +54,7 @@ def main() -> int:
     ap.add_argument("--out", type=Path)
     args = ap.parse_args()
     sides = {"old": args.old.resolve(), "new": args.new.resolve()}
-    lines = [f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()}, {len(os.sched_getaffinity(0))} cores: "
-             f"{args.rig} {args.preset}, old {sides['old']} ({commit_of(sides['old'])}), "
-             f"new {sides['new']} ({commit_of(sides['new'])})"]
+    lines = [header(f"{args.rig} {args.preset}", sides["old"], sides["new"])]
     print(lines[0], flush=True)
     configs = [(side, threads, busy) for busy in (False, True) for threads in (1, 2) for side in ("old", "new")]
     walls: dict[tuple, list[float]] = {c: [] for c in configs}
@@ -79,9 +75,7 @@ def main() -> int:
             o, n = statistics.median(walls[("old", threads, busy)]), statistics.median(walls[("new", threads, busy)])
             lines.append(f"| {'busy' if busy else 'quiet'} | {threads} | {o:.2f} | {n:.2f} | {o / n:.2f} |")
     print("\n".join(lines[-6:]))
-    if args.out:
-        with open(args.out, "a") as fh:
-            fh.write("\n".join(lines) + "\n")
+    save(lines, args.out)
     return 0
 
 

@@ -4,10 +4,13 @@
 #include "internal.h"
 
 /* Make d->split fit n rows and nth threads: kept (rescaled if n changed) when it was made for
- * nth threads, else even; split_threads = 0 where nth is beyond DEM_SPLIT_MAX. */
+ * nth threads, else even; split_threads = 0 where nth is beyond DEM_SPLIT_MAX. One thread has
+ * nothing to split: the split of a larger team is left as it is for the team's return (the
+ * thread governor's probes of one thread; thread_governor.c). */
 void dem_split_prepare(dem_domain *d, int nth)
 {
     const int64_t n = d->n;
+    if (nth == 1) return;
     if (nth < 1 || nth > DEM_SPLIT_MAX) {
         d->split_threads = 0;
         return;

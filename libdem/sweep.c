@@ -410,7 +410,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
     double maxdisp2 = 0.0;
     int64_t bad_nan = INT64_MAX, bad_out = INT64_MAX, bad_wall = INT64_MAX, bad_pair = INT64_MAX;
     const int team = dem_team(d);
-    if (team > 1) dem_split_prepare(d, team); /* (one thread: the split kept for the team's return) */
+    dem_split_prepare(d, team);
     int balanced = 0;                         /* the team used d->split */
     int64_t deferred_count[DEM_SPLIT_MAX]; /* then: each thread's deferred particles */
 #pragma omp parallel num_threads(team) reduction(max : maxdisp2) \
@@ -424,7 +424,7 @@ sweep_result dem_sweep(dem_domain *d, double dt_hist, sweep_mode mode)
         t_start = omp_get_wtime();
 #endif
         const sweep_ctx ctx = c; /* the thread's own copy: see sweep_view in sweep.h */
-        const int use_split = nth > 1 && nth == d->split_threads;
+        const int use_split = nth == d->split_threads;
         if (tid == 0) balanced = use_split;
         const int64_t r0 = use_split ? d->split[tid] : n * tid / nth, r1 = use_split ? d->split[tid + 1] : n * (tid + 1) / nth;
         sweep_result res;

@@ -21,7 +21,7 @@ def default_threads() -> int:
     try:
         return max(1, int(text))
     except ValueError:
-        return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
+        return os.cpu_count() or 1  # as the campaign runner counts cores
 
 
 class ConfigError(ValueError):
