@@ -11,7 +11,9 @@ effect can fit (a false alarm on a DEM null set did exactly that). So rows of on
 it with correlation exp(-d^2 / 2 l^2), d the distance of their conditions in the net's scaled
 inputs ([-1, 1] over the campaign range), l = NET_ERROR_LENGTH. And the points of one test (the
 shear points of one pre-shear stress: one specimen) share their specimen's scatter: the rows'
-seed-scatter parts correlate with the net's measured `test_correlation`. chi^2 is taken in the
+seed-scatter parts correlate with the net's measured `test_correlation`; so do the different
+quantities one run measures (`run_correlation`: a hopper run that flows slowly also takes
+longer to empty; `scatter_correlation`). chi^2 is taken in the
 whitened residuals L^-1 r (C = L L^T). `sigma` stays the marginal standard deviation of each row
 (QuantityNet.row_sigma), for tables and plots.
 
@@ -88,11 +90,10 @@ class Model:
         cov = np.diag(self.sigma ** 2 - e ** 2)
         for i, (oi, ni) in enumerate(zip(self.obs, self.nets)):
             for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):
-                if ni is not nj:
-                    continue
-                cov[i, j] += e[i] * e[j] * condition_correlation(ni, oi, oj)
-                if i != j and _same_test(oi, oj):
-                    cov[i, j] += getattr(ni, "test_correlation", 0.0) * s[i] * s[j]
+                if ni is nj:
+                    cov[i, j] += e[i] * e[j] * condition_correlation(ni, oi, oj)
+                if i != j:
+                    cov[i, j] += scatter_correlation(ni, oi, nj, oj) * s[i] * s[j]
         return cov
 
     def white(self, v: np.ndarray) -> np.ndarray:
@@ -161,9 +162,19 @@ class Model:
         return np.sum(r * r, axis=1)
 
 
-def _same_test(a: Observation, b: Observation) -> bool:
-    """Two points of one test: the same conditions but the shear fraction (one specimen)."""
-    return "shear_fraction" in a.conditions and "shear_fraction" in b.conditions and test_conditions(a) == test_conditions(b)
+def scatter_correlation(net_a, a: Observation, net_b, b: Observation) -> float:
+    """Correlation of the seed scatter of two different rows. Rows measured in one rig run (one
+    specimen: the same rig and the same conditions but the shear fraction) share it: two shear
+    points of one test with their net's `test_correlation`, two quantities of one run (a ring
+    shear's mu_ie_ps, mu_ie_s and bulk density; a hopper's flow rate, discharge time and bulk
+    density) with the correlation the replicates measure (`run_correlation`). Rows of different
+    runs, and repeated rows of one quantity without a shear fraction (separate specimens), do not."""
+    if a.quantity.rig != b.quantity.rig or test_conditions(a) != test_conditions(b):
+        return 0.0
+    if net_a is net_b:
+        both_points = "shear_fraction" in a.conditions and "shear_fraction" in b.conditions
+        return getattr(net_a, "test_correlation", 0.0) if both_points else 0.0
+    return getattr(net_a, "run_correlation", {}).get(b.quantity.metric, 0.0)
 
 
 def condition_correlation(net, a: Observation, b: Observation) -> float:

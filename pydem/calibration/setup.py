@@ -13,7 +13,7 @@ from ..measurements import load as load_measurements
 from .candidates import BASE_PARAMETERS, Candidate, registry
 from .pooled_runs import check_poolable
 from .quantities import Observation, ObservationError, observation, preset_conditions
-from .surrogates import load_or_train
+from .surrogates import attach_run_correlations, load_or_train, replicate_stores
 
 # the shipped diagnosis stores, one per rig (and stores pooled into one, open_store_groups): at the
 # rigs' tiny presets (the CI's, quick to remake) and at their default presets (the ones
@@ -100,7 +100,9 @@ def load_setup(paths, say=print, retrain: bool = False) -> Setup:
         missing = [n for n in BASE_PARAMETERS if n not in st.spec.ranges]
         if missing:
             raise ValueError(f"{st.path}: the diagnosis needs the base parameters {', '.join(missing)} varied")
-        nets.update(load_or_train(st, say, retrain, pooled=groups[rig][1]))
+        rig_nets = load_or_train(st, say, retrain, pooled=groups[rig][1])
+        attach_run_correlations(list(rig_nets.values()), replicate_stores(st, groups[rig][1]), say=lambda *a: None)
+        nets.update(rig_nets)
         for name, (lo, hi) in st.spec.ranges.items():
             if name in ranges:
                 lo, hi = max(lo, ranges[name][0]), min(hi, ranges[name][1])

@@ -14,7 +14,9 @@ scatter and the net's own error together, which is what separates one DEM run (o
 repeat) from the surrogate's smooth mean; the diagnosis adds it to every row's measurement
 uncertainty. A quantity measured at several points of one test (the shear points of one
 ring-shear run) also carries how much those points' errors go together: one specimen, one
-packing (`test_correlation`, measured on the store's runs). The error model (`fit_error_model`)
+packing (`test_correlation`); and the different quantities one run measures share its scatter
+too (`run_correlation`: a hopper run that flows slowly also empties late), both measured on the
+replicate runs. The error model (`fit_error_model`)
 says where the error is; the replicate runs say which part of it is seed scatter — one pooled sd,
 or a fixed fraction of the error model's sd where the replicates vary with it (`fit_scatter_ratio`)."""
 from __future__ import annotations
@@ -23,7 +25,7 @@ import hashlib
 import json
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +65,9 @@ class QuantityNet:
     # the seed scatter where the error model is: a fixed fraction of the total sd at a point, when the
     # replicates say so (fit_scatter_ratio); nan: the pooled `scatter` everywhere
     scatter_ratio: float = float("nan")
+    # correlation of one run's seed scatter with the other quantities the same run measures
+    # ({metric: rho}, run_correlations); measured from the replicates when the nets are loaded
+    run_correlation: dict = field(default_factory=dict)
 
     @property
     def seed_sd(self) -> float:
@@ -268,6 +273,26 @@ def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.n
     return float(np.sqrt(r2))
 
 
+def replicate_deviations(reps, columns: list[str]) -> list[np.ndarray]:
+    """Per replicated point of the stores `reps` that measure every metric column in `columns`:
+    its runs' deviations from the point's mean, each column in units of its sd at the point
+    ((runs, columns); runs counted for every column, at least 3, every sd positive)."""
+    dev = []
+    for rep in reps:
+        if not all(c in rep.metric_names for c in columns):
+            continue
+        idx = [rep.metric_names.index(c) for c in columns]
+        ok = np.all([counted_runs(rep, c) for c in columns], axis=0)
+        for p in np.unique(rep.points):
+            v = rep.values[(rep.points == p) & ok][:, idx]
+            if len(v) < 3:
+                continue
+            sd = v.std(axis=0, ddof=1)
+            if np.all(sd > 0):
+                dev.append((v - v.mean(axis=0)) / sd)
+    return dev
+
+
 def test_correlation(store, net: QuantityNet, reps=()) -> float:
     """How much one run's seed scatter at its several points (the shear fractions of one ring-
     shear run) goes together, clipped to [0, 0.95]; 0 for a quantity measured once per run. From
@@ -280,21 +305,11 @@ def test_correlation(store, net: QuantityNet, reps=()) -> float:
     points = fraction_columns(store.metric_names)
     if "shear_fraction" not in net.input_names or len(points) < 2:
         return 0.0
-    dev = []
-    for rep in reps:
-        cols = [j for j, _ in fraction_columns(rep.metric_names)]
-        for p in np.unique(rep.points):
-            v = rep.values[(rep.points == p) & (rep.status == 1)][:, cols]
-            v = v[np.all(np.isfinite(v), axis=1)]
-            if len(v) < 3:
-                continue
-            sd = v.std(axis=0, ddof=1)
-            if np.all(sd > 0):
-                dev.append((v - v.mean(axis=0)) / sd)
-    dev = [v for v in dev if v.shape[1] == dev[0].shape[1]] if dev else []  # stores with the same shear points
+    cols = [store.metric_names[j] for j, _ in points]
+    dev = replicate_deviations(reps, cols)
     if len(dev) >= 5:
         c = np.corrcoef(np.vstack(dev).T)
-        return float(np.clip(c[np.triu_indices(dev[0].shape[1], 1)].mean(), 0.0, 0.95))
+        return float(np.clip(c[np.triu_indices(len(cols), 1)].mean(), 0.0, 0.95))
     cols = np.array([store.values[:, j] - net(np.column_stack([store.params, np.full(len(store.params), frac)]))
                      for j, frac in points]).T
     r = cols[(store.status == 1) & np.all(np.isfinite(cols), axis=1)]
@@ -302,6 +317,63 @@ def test_correlation(store, net: QuantityNet, reps=()) -> float:
         return 0.0
     c = np.corrcoef(r.T)
     return float(np.clip(c[np.triu_indices(len(points), 1)].mean(), 0.0, 0.95))
+
+
+def _metric_columns(metric: str, metric_names: list[str]) -> list[str]:
+    """The store columns of a quantity's metric: itself, or mu_ie_s's shear-point columns."""
+    if metric == "mu_ie_s":
+        return [metric_names[j] for j, _ in fraction_columns(metric_names)]
+    return [metric] if metric in metric_names else []
+
+
+def run_correlations(reps, metrics: list[str]) -> dict[tuple[str, str], float]:
+    """{(a, b): rho} for every pair of different metrics that one run of the rig measures: the
+    correlation of the runs' seed deviations (replicate_deviations, pooled over the stores'
+    points; for mu_ie_s the mean over its shear points), where at least 5 points with 3 or more
+    runs measure both; else absent (0). Measured on the default stores (2026-11-28): a hopper
+    run's flow rate and discharge time -0.5 / -0.74 (whole box / one-effect axes), a ring-shear
+    run's mu_ie_ps and bulk density 0.41 / 0.16 (same point, same packing)."""
+    out = {}
+    names = reps[0].metric_names if reps else []
+    for i, a in enumerate(metrics):
+        for b in metrics[i + 1:]:
+            ca, cb = _metric_columns(a, names), _metric_columns(b, names)
+            if not ca or not cb:
+                continue
+            dev = replicate_deviations(reps, ca + cb)
+            if len(dev) < 5:
+                continue
+            c = np.corrcoef(np.vstack(dev).T)[:len(ca), len(ca):]
+            out[(a, b)] = out[(b, a)] = float(np.clip(c.mean(), -0.95, 0.95))
+    return out
+
+
+def one_run_correlation(nets: list[QuantityNet], rho: dict[tuple[str, str], float]) -> np.ndarray:
+    """The seed scatter's correlation matrix over the rows of one run (each quantity once, a
+    quantity with a shear fraction at three points), with the cross-quantity terms `rho`."""
+    rows = [n for n in nets for _ in range(3 if "shear_fraction" in n.input_names else 1)]
+    c = np.eye(len(rows))
+    for i, a in enumerate(rows):
+        for j, b in enumerate(rows):
+            if i != j:
+                c[i, j] = a.test_correlation if a is b else rho.get((a.quantity.metric, b.quantity.metric), 0.0)
+    return c
+
+
+def attach_run_correlations(nets: list[QuantityNet], reps, say=print) -> None:
+    """Sets each net's `run_correlation` from the replicate stores `reps` of its rig. Pairwise
+    estimates need not make a valid correlation matrix together: the cross-quantity terms are
+    scaled down (by 10 % steps) until one run's matrix is positive definite."""
+    rho = run_correlations(reps, [n.quantity.metric for n in nets])
+    for shrink in np.linspace(1.0, 0.0, 11):
+        scaled = {k: float(v * shrink) for k, v in rho.items()}
+        if np.linalg.eigvalsh(one_run_correlation(nets, scaled)).min() > 1e-3:
+            break
+    for n in nets:
+        n.run_correlation = {b: v for (a, b), v in scaled.items() if a == n.quantity.metric}
+    for (a, b), v in scaled.items():
+        if a < b:
+            say(f"  {nets[0].quantity.rig}: seed scatter of one run's {a} and {b} correlated {v:+.2f}")
 
 
 def store_hash(store, pooled=()) -> str:

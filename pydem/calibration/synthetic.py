@@ -177,22 +177,22 @@ def net_error_draw(nets: dict, obs: list[Observation], rng: np.random.Generator,
 
 def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generator,
                       truth_inputs: list | None = None) -> np.ndarray:
-    """One draw of the rigs' seed scatter over a programme, as DEM runs make it: one run per test,
-    so the points of one test (the shear points of one pre-shear stress) share a part of it
-    (the net's `test_correlation`), and different tests are independent. Its size: the nets'
-    error models at the truth's inputs where given."""
+    """One draw of the rigs' seed scatter over a programme, as DEM runs make it: one run per test
+    (a rig and its conditions but the shear fraction), whose rows share it as the likelihood says
+    (fit.scatter_correlation: the shear points of one test, the quantities of one run), and
+    different tests are independent. Its size: the nets' error models at the truth's inputs
+    where given."""
+    from .fit import scatter_correlation
     out = np.zeros(len(obs))
     tests: dict = {}
     for i, o in enumerate(obs):
-        key = (o.quantity, test_conditions(o))
-        tests.setdefault(key, []).append(i)
-    for (q, _), rows in tests.items():
-        net = nets[q]
-        rho = getattr(net, "test_correlation", 0.0) if len(rows) > 1 else 0.0
-        shared = rng.normal()
-        for i in rows:
-            sd = seed_sd_at(net, None if truth_inputs is None else truth_inputs[i])
-            out[i] = sd * (math.sqrt(rho) * shared + math.sqrt(1.0 - rho) * rng.normal())
+        tests.setdefault((o.quantity.rig, test_conditions(o)), []).append(i)
+    for rows in tests.values():
+        sd = np.array([seed_sd_at(nets[obs[i].quantity], None if truth_inputs is None else truth_inputs[i]) for i in rows])
+        c = np.array([[1.0 if i == j else scatter_correlation(nets[obs[i].quantity], obs[i], nets[obs[j].quantity], obs[j])
+                       for j in rows] for i in rows])
+        w, v = np.linalg.eigh(c)  # a square root that tolerates a semi-definite c
+        out[rows] = sd * (v @ (np.sqrt(np.clip(w, 0.0, None)) * rng.normal(size=len(rows))))
     return out
 
 

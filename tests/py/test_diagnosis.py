@@ -407,9 +407,83 @@ def test_the_specimen_correlation_comes_from_the_replicates():
         cov = np.full((3, 3), rho) + (1 - rho) * np.eye(3)
         dev = rng.multivariate_normal(np.zeros(3), cov, size=120) * rng.uniform(0.02, 0.2, 30).repeat(4)[:, None]
         rep = SimpleNamespace(metric_names=names, points=np.arange(30).repeat(4), status=np.ones(120, dtype=int),
-                              values=0.7 + dev)
+                              values=0.7 + dev, spec=SimpleNamespace(rig="ring-shear"))
         c = test_correlation(store, net, [rep])
         assert (abs(c - 0.6) < 0.15) if rho else (c <= 0.15), (rho, c)
+
+
+def _hopper_replicates(rng, rho, points=30, runs=4):
+    """A replicate store whose runs' flow-rate and discharge-time deviations correlate by rho
+    (each point its own scale), the bulk density independent of both."""
+    from types import SimpleNamespace
+    cov = np.array([[1.0, rho, 0.0], [rho, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    dev = rng.multivariate_normal(np.zeros(3), cov, size=points * runs) * rng.uniform(0.02, 0.2, points).repeat(runs)[:, None]
+    return SimpleNamespace(metric_names=["mass_flow_rate", "discharge_time", "bulk_density"], spec=SimpleNamespace(rig="hopper"),
+                           points=np.arange(points).repeat(runs), status=np.ones(points * runs, dtype=int),
+                           values=np.array([1.0, 1.5, 1300.0]) * (1.0 + dev))
+
+
+def test_the_quantities_of_one_run_correlate_as_the_replicates_say():
+    """run_correlations from a replicate store whose flow-rate and discharge-time deviations
+    correlate by -0.7: within 0.12 of it (90 deviations with 3 degrees of freedom per point of 4
+    runs: standard error ~0.06), and the independent bulk density within 0.25 of 0 (~4 sd)."""
+    from pydem.calibration.surrogates import run_correlations
+    rho = run_correlations([_hopper_replicates(np.random.default_rng(11), -0.7)],
+                           ["mass_flow_rate", "discharge_time", "bulk_density"])
+    assert abs(rho[("mass_flow_rate", "discharge_time")] + 0.7) < 0.12, rho
+    assert rho[("discharge_time", "mass_flow_rate")] == rho[("mass_flow_rate", "discharge_time")]
+    assert abs(rho[("bulk_density", "discharge_time")]) < 0.25 and abs(rho[("mass_flow_rate", "bulk_density")]) < 0.25, rho
+
+
+def test_pairwise_run_correlations_are_made_a_valid_matrix():
+    """Three quantities each pair correlated -0.9 cannot all hold at once (the matrix has a
+    negative eigenvalue): attach_run_correlations scales them down until one run's matrix is
+    positive definite, and leaves a valid set (-0.3 each) as measured."""
+    from pydem.calibration import surrogates
+    from pydem.calibration.surrogates import QuantityNet, attach_run_correlations, one_run_correlation
+    metrics = ["mass_flow_rate", "discharge_time", "bulk_density"]
+    nets = [QuantityNet(Quantity("hopper", m), ["a"], np.zeros(1), np.ones(1), 0.0, 1.0, np.zeros((1, 1)), np.zeros(1),
+                        np.zeros(1), 0.0, rmse=0.1, r2=0.5, runs=100) for m in metrics]
+    for r, kept in ((-0.9, False), (-0.3, True)):
+        pairs = {(a, b): r for a in metrics for b in metrics if a != b}
+        original = surrogates.run_correlations
+        surrogates.run_correlations = lambda reps, ms: dict(pairs)
+        try:
+            attach_run_correlations(nets, [], say=lambda *a: None)
+        finally:
+            surrogates.run_correlations = original
+        got = nets[0].run_correlation["discharge_time"]
+        assert (got == pytest.approx(r)) if kept else (r < got < 0.0), (r, got)
+        assert np.linalg.eigvalsh(one_run_correlation(nets, {(a.quantity.metric, b): v for a in nets
+                                                             for b, v in a.run_correlation.items()})).min() > 0
+
+
+def test_the_rows_of_one_run_share_its_scatter_in_the_likelihood_and_in_synthetic_sets():
+    """A hopper run's flow rate and discharge time (same slot) share their seed scatter with the
+    nets' run_correlation, rows at another slot do not; the covariance written out by hand. And
+    the surrogate sets' scatter draws have that correlation: 4,000 draws within 0.05 of -0.6
+    (standard error ~0.01) and the other slot's rows within 0.05 of 0."""
+    from pydem.calibration.synthetic import seed_scatter_draw
+    qs = [Quantity("hopper", "mass_flow_rate"), Quantity("hopper", "discharge_time")]
+    nets = {}
+    for k, q in enumerate(qs):
+        net = LinearNet(q, [0.5, 0.2, 0.0, 0.1, 0.0], [0.0] * 5, 1.0 + k, sigma=0.02 * (k + 1))
+        net.input_names = INPUTS[:5] + ["slot_width"]
+        net.lo, net.hi = np.append(net.lo[:5], 0.03), np.append(net.hi[:5], 0.08)
+        net.test_correlation, net.run_correlation = 0.0, {qs[1 - k].metric: -0.6}
+        nets[q] = net
+    obs = [Observation(q, {"slot_width": b}, 1.0, 0.0, "r") for b in (0.04, 0.07) for q in qs]
+    m = Model(obs, nets, RANGES, CANDS)
+    s = np.array([0.02, 0.04, 0.02, 0.04])
+    expect = np.diag(s * s)
+    expect[0, 1] = expect[1, 0] = expect[2, 3] = expect[3, 2] = -0.6 * 0.02 * 0.04
+    assert np.allclose(m.cov, expect, rtol=1e-12, atol=0)
+    rng = np.random.default_rng(12)
+    draws = np.array([seed_scatter_draw(nets, obs, rng) for _ in range(4000)])
+    c = np.corrcoef(draws.T)
+    assert abs(c[0, 1] + 0.6) < 0.05 and abs(c[2, 3] + 0.6) < 0.05, c
+    assert abs(c[0, 2]) < 0.05 and abs(c[1, 3]) < 0.05, c
+    assert draws.std(axis=0) == pytest.approx(s, rel=0.05)
 
 
 def test_a_log_output_quantity_net_has_the_gradient_of_exp():

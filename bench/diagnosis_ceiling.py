@@ -1,0 +1,113 @@
+"""The best top-1 rate any method can reach on the hidden-effect protocol (docs/diagnosis.md §7).
+
+For each surrogate-generated set of `diagnosis_validation.py` (same seeds, same draws) it takes
+the set's *signal*: the base model's chi^2 at its best fit to the set's noise-free values, the
+noncentrality of the likelihood-ratio test of the true effect. An oracle that knows which effect
+is hidden and tests only it, at the loop's level (alpha = 0.01; one-sided for cohesion), finds it
+with probability P(noncentral chi^2_1(signal) > critical value): the Neyman-Pearson bound for one
+parameter. Summed over the sets it is the expected top-1 count no diagnosis can beat at that false-
+alarm level. Two versions:
+
+- with the likelihood's sigma (the rows' uncertainty, the rig's seed scatter and the nets' own
+  error): the ceiling with these surrogates;
+- with the nets' own error set to zero: the ceiling of the protocol itself (its conditions, its
+  lab noise and the rigs' seed scatter), whatever the surrogates.
+
+    .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30
+    .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30 --floor 0   # strengths from 0
+
+Writes bench/results/diagnosis_ceiling_<label>.json and prints the table."""
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from pydem.calibration import synthetic  # noqa: E402
+from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
+from pydem.calibration.surrogates import QuantityNet  # noqa: E402
+
+ALPHA = 0.01
+
+
+def oracle_power(signal: float, one_sided: bool) -> float:
+    """P(the true effect's LR test rejects at ALPHA) for noncentrality `signal`."""
+    crit = stats.chi2.isf(2 * ALPHA if one_sided else ALPHA, 1)
+    return float(stats.ncx2.sf(crit, 1, max(signal, 1e-12)))
+
+
+def without_net_error(fn):
+    """Runs fn() with every net's own error at (almost) zero: sigma = max(u, seed scatter)."""
+    original = QuantityNet.errors_at
+
+    def seed_only(self, x):
+        seed, err = original(self, x)
+        return seed, 1e-6 * err
+    QuantityNet.errors_at = seed_only
+    try:
+        return fn()
+    finally:
+        QuantityNet.errors_at = original
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--preset", default="default")
+    ap.add_argument("--sets", type=int, default=30, help="sets per candidate effect")
+    ap.add_argument("--seed", type=int, default=1, help="as diagnosis_validation.py's --seed: the same sets")
+    ap.add_argument("--floor", type=float, default=None,
+                    help="smallest strength as a fraction of neutral-to-edge (default: the protocol's)")
+    ap.add_argument("--label", help="results name (default: the preset, with the floor when given)")
+    args = ap.parse_args()
+    stores = [ROOT / s for s in shipped_stores(args.preset)]
+    setup = load_setup([s for s in stores if s.exists()], say=lambda *a: None)
+    base_obs = synthetic.programme(setup.nets)
+    draw_kw = {} if args.floor is None else {"min_fraction": args.floor}
+    t0 = time.perf_counter()
+    rows = []
+    for c in setup.candidates:
+        for k in range(args.sets):
+            rng = np.random.default_rng([args.seed, sum(map(ord, c.name)), k])  # validate()'s draws
+            truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, c.name, **draw_kw)
+            obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, True)
+            s_nets = synthetic.signal(setup, truth, obs)
+            s_exact = without_net_error(lambda: synthetic.signal(setup, truth, obs))
+            one = c.side == "+"
+            rows.append({"effect": c.name, "set": k, "strength": truth.strength, "signal": s_nets,
+                         "signal_without_net_error": s_exact,
+                         "power": oracle_power(s_nets, one), "power_without_net_error": oracle_power(s_exact, one)})
+            print(f"  {c.name:14s} #{k:2d} strength {truth.strength:9.4g}  signal {s_nets:7.1f} "
+                  f"(exact nets {s_exact:7.1f})  oracle {rows[-1]['power']:.2f} / {rows[-1]['power_without_net_error']:.2f}",
+                  flush=True)
+    table = {}
+    for c in setup.candidates:
+        r = [x for x in rows if x["effect"] == c.name]
+        table[c.name] = {"sets": len(r), "oracle_top1": sum(x["power"] for x in r),
+                         "oracle_top1_without_net_error": sum(x["power_without_net_error"] for x in r),
+                         "median_signal": float(np.median([x["signal"] for x in r])),
+                         "median_signal_without_net_error": float(np.median([x["signal_without_net_error"] for x in r]))}
+    label = args.label or (args.preset if args.floor is None else f"{args.preset}_floor{args.floor:g}")
+    out = ROOT / f"bench/results/diagnosis_ceiling_{label}.json"
+    meta = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{platform.machine()}, 2 cores",
+            "seconds": time.perf_counter() - t0, "alpha": ALPHA, "command": " ".join(sys.argv)}
+    out.write_text(json.dumps({"meta": meta, "table": table, "sets": rows}, indent=1))
+    print(f"\nexpected top-1 of an oracle at alpha {ALPHA} ({args.sets} sets per effect):")
+    for name, t in table.items():
+        print(f"  {name:14s} with these nets {t['oracle_top1']:5.1f} ({t['oracle_top1'] / t['sets']:.0%})   "
+              f"nets exact {t['oracle_top1_without_net_error']:5.1f} ({t['oracle_top1_without_net_error'] / t['sets']:.0%})   "
+              f"median signal {t['median_signal']:.1f} / {t['median_signal_without_net_error']:.1f}")
+    print(f"-> {out} ({meta['seconds']:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
