@@ -213,10 +213,11 @@ def signal(setup, truth: Truth, obs: list[Observation]) -> float:
 
 
 def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], seed: int, threads: int = 1,
-               say=print, progress=None) -> dict[int, float]:
+               say=print, progress=None, extra: dict | None = None) -> dict[int, float]:
     """One rig run per condition group of `obs` at the stores' presets with the given parameter
     values (a ring-shear run measures its pre-shear and every shear point): {observation index:
-    value}. An observation whose run failed is missing from the result."""
+    value}. An observation whose run failed is missing from the result. `extra`: settings no
+    store varies, given to every run (an effect that is not a candidate)."""
     from ..rigs import RIGS
     import time
     groups: dict = {}
@@ -228,6 +229,7 @@ def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], s
         store = stores[rig]
         point = {k: inputs[k] for k in store.spec.names if k in inputs}
         point.update({k: v for k, v in cond})
+        point.update(extra or {})
         cfg = store.spec.config(point)
         fractions = sorted({obs[i].conditions["shear_fraction"] for i in idx if "shear_fraction" in obs[i].conditions})
         if fractions:
