@@ -27,6 +27,7 @@ import numpy as np
 from scipy import stats
 
 from .candidates import Candidate
+from .detectability import detectable_effects
 from .calibrate import fit_base, fit_summary, residual_table, row_notes, weak_surrogates, window_screen
 from .fit import Fit, Model, minimise, posterior
 from .quantities import Observation, test_conditions
@@ -82,6 +83,7 @@ class Diagnosis:
     testable: bool = True        # more measurements than base parameters: candidates could be tested
     window: dict = field(default_factory=dict)  # seed 000's ±5 % admissible set of the final model
     outliers: list[dict] = field(default_factory=list)  # rows set aside (outlier_screen), with why
+    detectable: dict = field(default_factory=dict)  # per candidate: the smallest effect these rows would show
 
     def summary_of(self, fit: Fit | None, model: Model | None) -> dict | None:
         if fit is None:
@@ -108,7 +110,8 @@ class Diagnosis:
                 "correlation": {"names": final.posterior.get("names"), "matrix": final.posterior.get("correlation")},
                 "admissible_window": self.window,
                 "similarity": self.similarity, "separating_condition": self.separating,
-                "groups": self.groups, "outliers": self.outliers, "residuals_before": self.residual_table(False),
+                "groups": self.groups, "outliers": self.outliers, "detectable": self.detectable,
+                "residuals_before": self.residual_table(False),
                 "residuals_after": self.residual_table(True) if self.after is not None else None,
                 "notes": self.notes}
 
@@ -307,6 +310,7 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
         say(f"  {c.name:16s} LR {lr:8.2f}  p {p:9.2g}  dBIC {res.delta_bic:8.2f}  score {s:8.2f}  "
             f"estimate {res.estimate:.4g} {c.unit}")
     results.sort(key=lambda r: (-r.statistic, r.effect))
+    detectable = detectable_effects(ref_model, ref, covered_for_tests, nets, ranges, covered, ALPHA) if covered_for_tests else {}
     similarity = {}
     for i, a in enumerate(results):
         for b in results[i + 1:]:
@@ -358,4 +362,5 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
     window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
-                     after, after_model, similarity, separating, groups, loco, notes, testable, window)
+                     after, after_model, similarity, separating, groups, loco, notes, testable, window,
+                     detectable=detectable)

@@ -227,6 +227,8 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
                       + ", ".join(f"{kk}={vv:.4g}" for kk, vv in s["conditions"].items())
                       + f" (the two explanations differ there by {s['difference_in_sigma']:.1f} sigma).")
     sections.append(("Candidate effects", md + extra, h + "".join(f"<p>{html.escape(x)}</p>" for x in extra.split("\n\n") if x)))
+    if d.detectable:
+        sections.append(detectable_section(d.detectable, {c.effect: c.unit for c in d.candidates}))
     sections.append(parameter_section(data["parameters"], data.get("admissible_window"),
                                       "Parameters" + (f" (with {d.effect})" if d.after is not None else "")))
     for title, key in (("Residuals, base model", "residuals_before"), ("Residuals, with the effect", "residuals_after")):
@@ -243,6 +245,26 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     if d.notes:
         sections.append(notes_section(d.notes))
     return write_page(out, f"Diagnosis: {d.material}", sections, plots, head=2)
+
+
+def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
+    """What these measurements can see: per candidate, the smallest effect on each side that the
+    test finds with 90 % probability (detectability.py)."""
+    def side(v, info, key):
+        if key not in info:
+            return "(one-sided)"
+        return _g(v) if v is not None else f"not within the range (signal at its edge {info['signal_at_edge'][key]:.1f})"
+    rows = [[name, f"{_g(info['neutral'])} {units.get(name, '')}".strip(), side(info.get("below"), info, "below"),
+             side(info.get("above"), info, "above")] for name, info in detectable.items()]
+    md, h = _table(rows, ["candidate", "neutral (base model)", "detectable below", "detectable above"])
+    any_info = next(iter(detectable.values()))
+    needed = " or ".join(sorted({f"{i['signal_needed']:.1f}" for i in detectable.values()}))
+    line = (f"The smallest effect each test finds with {100 * any_info['power']:g} % probability at p = "
+            f"{any_info['alpha']:g}, at the base model's fit and with these rows' uncertainties (a likelihood-ratio "
+            f"signal of {needed}): an effect closer to the neutral value than this can hide in these "
+            f"measurements, so a clean verdict does not rule it out. Measuring at conditions where the effect is "
+            f"larger, or with smaller uncertainties, moves these limits.")
+    return ("What these measurements can see", md + "\n\n" + line, h + f"<p>{html.escape(line)}</p>")
 
 
 def parameter_section(params: dict, window: dict | None, title: str) -> tuple[str, str, str]:

@@ -188,6 +188,30 @@ def test_a_smooth_net_error_over_the_conditions_raises_no_alarm():
     assert alarms <= 3, alarms
 
 
+def test_the_smallest_detectable_effect_is_the_closed_form_in_a_linear_world():
+    """In a linear model the likelihood-ratio signal of an effect eta is eta^2 |M^1/2 J_E|^2 (the
+    score test's information), so the smallest effect found with 90 % probability is
+    sqrt(lambda_90 / information), lambda_90 the noncentral chi^2_1 parameter for that power (14.88
+    two-sided at p = 0.01, 13.02 one-sided): detectability.py's scan and root search give it
+    within 1e-4 relative (root tolerance 1e-6 of the range), on both sides of the two-sided
+    candidate, and the one-sided one has no side below its neutral value."""
+    from pydem.calibration.detectability import noncentrality_for_power
+    nets, obs = world()
+    data = generate(nets, obs, (0.4, 0.5, 0.5), {}, np.random.default_rng(21))
+    d = dg.diagnose("null", data, nets, RANGES, CANDS, say=lambda *a: None)
+    assert noncentrality_for_power(0.01, False) == pytest.approx(14.879, abs=2e-3)
+    assert noncentrality_for_power(0.01, True) == pytest.approx(13.017, abs=2e-3)
+    for c in CANDS:
+        _, _, mje = dg._score(d.base_model, d.base, c.parameter)
+        mde = math.sqrt(noncentrality_for_power(0.01, c.side == "+") / float(mje @ mje))
+        info = d.detectable[c.name]
+        assert info["above"] == pytest.approx(mde, rel=1e-4), (c.name, info, mde)
+        if c.side == "+":
+            assert "below" not in info
+        else:
+            assert info["below"] == pytest.approx(-mde, rel=1e-4), (c.name, info, mde)
+
+
 def test_one_sided_candidate_rejects_a_negative_effect():
     """Cohesion-like candidates are one-sided: data that would need eta_a < 0 (impossible) must
     not be explained by them (its statistic is 0, its estimate stays at neutral)."""
