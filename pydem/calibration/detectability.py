@@ -57,7 +57,8 @@ def smallest_detectable(ref_model: Model, base: Fit, candidate: Candidate, nets:
     target = noncentrality_for_power(alpha, one_sided)
     effect_model = Model(ref_model.obs, nets, ranges, covered, candidate, at=np.append(base.best, neutral))
     effect_model.y = ref_model.y  # predictions only; its noise model is never used
-    out = {"neutral": neutral, "power": POWER, "alpha": alpha, "signal_needed": target, "signal_at_edge": {}}
+    out = {"neutral": neutral, "range": [float(lo), float(hi)], "power": POWER, "alpha": alpha, "signal_needed": target,
+           "signal_at_edge": {}}
     sides = [("above", hi)] + ([] if one_sided else [("below", lo)])
     for side, edge in sides:
         if abs(edge - neutral) < 1e-12 * max(1.0, abs(edge)):

@@ -30,10 +30,24 @@ def verdict_line(d: Diagnosis) -> str:
     if not d.testable:
         line += (f" But with {len(d.observations)} measurement(s) for {len(d.base.names)} base parameters no candidate "
                  f"effect could be tested: measure more conditions.")
+    if d.verdict == "no_effect_needed" and d.detectable:
+        hidden = [f"{name} {_limits(info)}" for name, info in d.detectable.items()]
+        line += (" It does not rule out effects these measurements cannot show (below their 90 % detection limits): "
+                 + "; ".join(hidden) + ".")
     edges = [n for n, p in d.base.posterior.get("parameters", {}).items() if p.get("at_edge")]
     if edges:
         line += f" The base estimate sits at the edge of the campaign range for {', '.join(edges)}."
     return line
+
+
+def _limits(info: dict) -> str:
+    """'0.05-0.31' / 'below 2e4': where an effect would go unseen (detectability.py's limits about
+    the neutral value, the campaign range's edges where a side has none)."""
+    lo = info["neutral"] if "below" not in info else info["below"] if info["below"] is not None else info["range"][0]
+    hi = info["above"] if info.get("above") is not None else info["range"][1]
+    if "below" not in info:
+        return f"below {hi:.3g}"
+    return f"{lo:.3g}–{hi:.3g}"
 
 
 def _png(fig) -> bytes:

@@ -210,6 +210,10 @@ def test_the_smallest_detectable_effect_is_the_closed_form_in_a_linear_world():
             assert "below" not in info
         else:
             assert info["below"] == pytest.approx(-mde, rel=1e-4), (c.name, info, mde)
+    from pydem.calibration.report import verdict_line
+    assert d.verdict == "no_effect_needed"
+    line = verdict_line(d)  # a clean verdict states what it does not rule out
+    assert f"a below {d.detectable['a']['above']:.3g}" in line and f"b {d.detectable['b']['below']:.3g}–" in line, line
 
 
 def test_one_sided_candidate_rejects_a_negative_effect():
