@@ -15,6 +15,12 @@ alarm level. Two versions:
 
     .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30
     .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30 --floor 0   # strengths from 0
+    .venv/bin/python bench/diagnosis_ceiling.py --preset default --dem   # the DEM-made sets' truths
+
+With --dem, the sets are those of the committed DEM-made journals (`dem_sets_default*.jsonl`): each
+set's signal is taken on the surrogates at its truth with its rows' stated uncertainties (the
+rigs' own mean response is unknown), and the oracle is set beside the verdicts in
+`*.diagnosed.json`.
 
 Writes bench/results/diagnosis_ceiling_<label>.json and prints the table."""
 from __future__ import annotations
@@ -67,9 +73,12 @@ def main() -> int:
     ap.add_argument("--floor", type=float, default=None,
                     help="smallest strength as a fraction of neutral-to-edge (default: the protocol's)")
     ap.add_argument("--label", help="results name (default: the preset, with the floor when given)")
+    ap.add_argument("--dem", action="store_true", help="the DEM-made journals' sets instead of surrogate ones")
     args = ap.parse_args()
     stores = [ROOT / s for s in shipped_stores(args.preset)]
     setup = load_setup([s for s in stores if s.exists()], say=lambda *a: None)
+    if args.dem:
+        return dem_ceiling(setup, args)
     base_obs = synthetic.programme(setup.nets)
     draw_kw = {} if args.floor is None else {"min_fraction": args.floor}
     t0 = time.perf_counter()
@@ -106,6 +115,39 @@ def main() -> int:
               f"nets exact {t['oracle_top1_without_net_error']:5.1f} ({t['oracle_top1_without_net_error'] / t['sets']:.0%})   "
               f"median signal {t['median_signal']:.1f} / {t['median_signal_without_net_error']:.1f}")
     print(f"-> {out} ({meta['seconds']:.0f} s)")
+    return 0
+
+
+def dem_ceiling(setup, args) -> int:
+    """The oracle's expected top-1 on the DEM-made sets' truths, beside the loop's verdicts."""
+    from pydem.calibration.quantities import Quantity
+    rows = []
+    for journal in sorted((ROOT / "bench/results").glob("dem_sets_default*.jsonl")):
+        diagnosed = journal.with_suffix(".diagnosed.json")
+        if not diagnosed.exists():
+            continue
+        verdicts = {v["set"]: v for v in json.loads(diagnosed.read_text())}
+        for k, line in enumerate(journal.read_text().splitlines()):
+            row = json.loads(line)
+            c = next((c for c in setup.candidates if c.name == row["kind"]), None)
+            if c is None or k not in verdicts:
+                continue
+            v = verdicts[k]
+            truth, obs = synthetic.journal_set(row, setup.nets, setup.candidates, np.random.default_rng(5000 + k),
+                                               keep=lambda r: Quantity(r["rig"], r["metric"]) in setup.nets)
+            s = synthetic.signal(setup, truth, obs)
+            rows.append({"journal": journal.name, "set": k, "effect": c.name, "strength": truth.strength, "signal": s,
+                         "power": oracle_power(s, c.side == "+"), "named": v["effect"] == c.name})
+    table = {c.name: {"sets": sum(r["effect"] == c.name for r in rows),
+                      "oracle_top1": sum(r["power"] for r in rows if r["effect"] == c.name),
+                      "loop_top1": sum(r["named"] for r in rows if r["effect"] == c.name)} for c in setup.candidates}
+    out = ROOT / f"bench/results/diagnosis_ceiling_{args.label or args.preset}_dem.json"
+    out.write_text(json.dumps({"meta": {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                                        "command": " ".join(sys.argv)}, "table": table, "sets": rows}, indent=1))
+    print(f"DEM-made sets: expected top-1 of an oracle at alpha {ALPHA} (signal on the surrogates) and the loop's:")
+    for name, t in table.items():
+        print(f"  {name:14s} {t['sets']} sets: oracle {t['oracle_top1']:.1f}, loop {t['loop_top1']}")
+    print(f"-> {out}")
     return 0
 
 
