@@ -79,6 +79,68 @@ def smallest_detectable(ref_model: Model, base: Fit, candidate: Candidate, nets:
     return out
 
 
+def information(model: Model, p: np.ndarray, parameter: str) -> float:
+    """|M^1/2 J_E|^2 at the base parameters p: how strongly the rows tell a small step of the
+    candidate's input from what the base parameters can re-adjust (the score test's information;
+    the signal of a small effect eta is (eta - neutral)^2 times this)."""
+    jt = model.white(model.jacobian(p))
+    je = model.white(model.net_jacobian(p, parameter))
+    mje = je - jt @ np.linalg.solve(jt.T @ jt + 1e-12 * np.eye(jt.shape[1]), jt.T @ je)
+    return float(mje @ mje)
+
+
+def candidate_tests(observations: list, nets: dict, points: int = 4) -> list[tuple[str, list]]:
+    """Tests a user could add: for every rig with surrogates, one run at each of `points` values of
+    its test condition over the campaign range (log-spaced for the pre-shear stress), giving every
+    quantity the rig measures (the shear points at the fractions observed, else 40/60/80 %).
+    [(label, rows)]."""
+    from .quantities import CONDITION_UNITS, CONDITIONS, Observation
+    fractions = sorted({o.conditions["shear_fraction"] for o in observations if "shear_fraction" in o.conditions}) \
+        or [0.4, 0.6, 0.8]
+    tests = []
+    for rig in sorted({q.rig for q in nets}):
+        quantities = [q for q in nets if q.rig == rig]
+        net = nets[quantities[0]]
+        cond = [c for c in CONDITIONS.get(rig, ()) if c != "shear_fraction" and c in net.input_names]
+        values = [None]
+        if cond:
+            j = net.input_names.index(cond[0])
+            lo, hi = float(net.lo[j]), float(net.hi[j])
+            values = np.geomspace(lo, hi, points) if cond[0] == "preshear_stress" else np.linspace(lo, hi, points)
+        for v in values:
+            at = {} if v is None else {cond[0]: float(v)}
+            rows = []
+            for q in quantities:
+                for f in (fractions if "shear_fraction" in nets[q].input_names else [None]):
+                    c = dict(at) if f is None else dict(at, shear_fraction=f)
+                    rows.append(Observation(q, c, 1.0, 0.0, f"{q.key} {c}"))
+            tests.append((f"{rig}" + (f" at {cond[0]} = {v:.4g} {CONDITION_UNITS.get(cond[0], '')}".rstrip()
+                                      if v is not None else ""), rows))
+    return tests
+
+
+def best_next_measurement(ref_model: Model, base: Fit, candidate: Candidate, tests: list, nets: dict, ranges: dict,
+                          covered: list[Candidate]) -> dict | None:
+    """The one extra test (of `tests`: candidate_tests) that would lower the candidate's detection
+    limit most, in the linearised view: the information with that test's rows added (their
+    uncertainty the rig's seed scatter and the net's error there, their correlations as the
+    likelihood has them), the limit scaling as information^-1/2. {"test", "limit_ratio"} (new
+    limit / now, < 1), or None without a gain."""
+    now = information(ref_model, base.best, candidate.parameter)
+    best = None
+    for label, rows in tests:
+        try:
+            m = Model(ref_model.obs + rows, nets, ranges, covered, at=base.best)
+        except ValueError:  # a test whose rows these surrogates cannot evaluate (an input they lack)
+            continue
+        gain = information(m, base.best, candidate.parameter)
+        if gain > now * (1 + 1e-9) and (best is None or gain > best[0]):
+            best = (gain, label)
+    if best is None or now <= 0:
+        return None
+    return {"test": best[1], "limit_ratio": float(np.sqrt(now / best[0]))}
+
+
 def detectable_effects(ref_model: Model, base: Fit, candidates: list[Candidate], nets: dict, ranges: dict,
                        covered: list[Candidate], alpha: float) -> dict:
     """{candidate name: smallest_detectable(...)} for every candidate tested."""

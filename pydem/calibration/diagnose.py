@@ -27,7 +27,7 @@ import numpy as np
 from scipy import stats
 
 from .candidates import Candidate
-from .detectability import detectable_effects
+from .detectability import best_next_measurement, candidate_tests, detectable_effects
 from .calibrate import fit_base, fit_summary, residual_table, row_notes, weak_surrogates, window_screen
 from .fit import Fit, Model, minimise, posterior
 from .quantities import Observation, test_conditions
@@ -310,7 +310,12 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
         say(f"  {c.name:16s} LR {lr:8.2f}  p {p:9.2g}  dBIC {res.delta_bic:8.2f}  score {s:8.2f}  "
             f"estimate {res.estimate:.4g} {c.unit}")
     results.sort(key=lambda r: (-r.statistic, r.effect))
-    detectable = detectable_effects(ref_model, ref, covered_for_tests, nets, ranges, covered, ALPHA) if covered_for_tests else {}
+    detectable = {}
+    if covered_for_tests:
+        detectable = detectable_effects(ref_model, ref, covered_for_tests, nets, ranges, covered, ALPHA)
+        tests = candidate_tests(observations, nets)
+        for c in covered_for_tests:
+            detectable[c.name]["measure_next"] = best_next_measurement(ref_model, ref, c, tests, nets, ranges, covered)
     similarity = {}
     for i, a in enumerate(results):
         for b in results[i + 1:]:

@@ -268,16 +268,22 @@ def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
         if key not in info:
             return "(one-sided)"
         return _g(v) if v is not None else f"not within the range (signal at its edge {info['signal_at_edge'][key]:.1f})"
+    def next_test(info):
+        n = info.get("measure_next")
+        return f"{n['test']} (limits × {n['limit_ratio']:.2f})" if n else "-"
     rows = [[name, f"{_g(info['neutral'])} {units.get(name, '')}".strip(), side(info.get("below"), info, "below"),
-             side(info.get("above"), info, "above")] for name, info in detectable.items()]
-    md, h = _table(rows, ["candidate", "neutral (base model)", "detectable below", "detectable above"])
+             side(info.get("above"), info, "above"), next_test(info)] for name, info in detectable.items()]
+    md, h = _table(rows, ["candidate", "neutral (base model)", "detectable below", "detectable above",
+                          "one more test that would lower the limits most"])
     any_info = next(iter(detectable.values()))
     needed = " or ".join(sorted({f"{i['signal_needed']:.1f}" for i in detectable.values()}))
     line = (f"The smallest effect each test finds with {100 * any_info['power']:g} % probability at p = "
             f"{any_info['alpha']:g}, at the base model's fit and with these rows' uncertainties (a likelihood-ratio "
             f"signal of {needed}): an effect closer to the neutral value than this can hide in these "
-            f"measurements, so a clean verdict does not rule it out. Measuring at conditions where the effect is "
-            f"larger, or with smaller uncertainties, moves these limits.")
+            f"measurements, so a clean verdict does not rule it out. The last column: the one extra test (a run of a "
+            f"rig at one condition, all its quantities) that would lower the limits most, in the linearised view "
+            f"(limits scale as the test's information to the power -1/2); a test that pins the base parameters "
+            f"down where the effect is small can help as much as one where it is large.")
     return ("What these measurements can see", md + "\n\n" + line, h + f"<p>{html.escape(line)}</p>")
 
 

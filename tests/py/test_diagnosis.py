@@ -210,6 +210,22 @@ def test_the_smallest_detectable_effect_is_the_closed_form_in_a_linear_world():
             assert "below" not in info
         else:
             assert info["below"] == pytest.approx(-mde, rel=1e-4), (c.name, info, mde)
+    # the test that would lower a limit most, against the information written out by hand: a row's
+    # sigma is sqrt(u^2 + 0.01^2) (LinearNet.row_sigma: no net error), J the linear world's slopes
+    from pydem.calibration.detectability import best_next_measurement
+
+    def info(rows, k):
+        jac = np.array([[nets[o.quantity].a[i] + nets[o.quantity].b[i] * o.conditions["condition"] for i in range(5)]
+                        for o in rows]) / np.array([[math.hypot(o.uncertainty, 0.01)] for o in rows])
+        jb, je = jac[:, :3], jac[:, 3 + k]
+        return float(np.sum((je - jb @ np.linalg.lstsq(jb, je, rcond=None)[0]) ** 2))
+    tests = [(f"c={c}", [Observation(q, {"condition": c}, 1.0, 0.0, "t") for q in Q]) for c in (0.0, 0.5, 1.0)]
+    ref = Model(data, nets, RANGES, CANDS, at=d.base.best)
+    for k, c in enumerate(CANDS):
+        now = info(data, k)
+        best = max(tests, key=lambda t: info(data + t[1], k))
+        got = best_next_measurement(ref, d.base, c, tests, nets, RANGES, CANDS)
+        assert got["test"] == best[0] and got["limit_ratio"] == pytest.approx(math.sqrt(now / info(data + best[1], k)), rel=1e-9)
     from pydem.calibration.report import verdict_line
     assert d.verdict == "no_effect_needed"
     line = verdict_line(d)  # a clean verdict states what it does not rule out
