@@ -13,7 +13,7 @@ inputs ([-1, 1] over the campaign range), l = NET_ERROR_LENGTH. And the points o
 shear points of one pre-shear stress: one specimen) share their specimen's scatter: the rows'
 seed-scatter parts correlate with the net's measured `test_correlation`; so do the different
 quantities one run measures (`run_correlation`: a hopper run that flows slowly also takes
-longer to empty; `scatter_correlation`). chi^2 is taken in the
+longer to empty; `scatter_correlations`). chi^2 is taken in the
 whitened residuals L^-1 r (C = L L^T). `sigma` stays the marginal standard deviation of each row
 (QuantityNet.row_sigma), for tables and plots.
 
@@ -88,12 +88,13 @@ class Model:
         the conditions within one quantity (module docstring)."""
         e, s = self._err, self._seed
         cov = np.diag(self.sigma ** 2 - e ** 2)
+        rho = scatter_correlations(self.obs, self.nets)
         for i, (oi, ni) in enumerate(zip(self.obs, self.nets)):
             for j, (oj, nj) in enumerate(zip(self.obs, self.nets)):
                 if ni is nj:
                     cov[i, j] += e[i] * e[j] * condition_correlation(ni, oi, oj)
                 if i != j:
-                    cov[i, j] += scatter_correlation(ni, oi, nj, oj) * s[i] * s[j]
+                    cov[i, j] += rho[i, j] * s[i] * s[j]
         return cov
 
     def white(self, v: np.ndarray) -> np.ndarray:
@@ -162,19 +163,33 @@ class Model:
         return np.sum(r * r, axis=1)
 
 
-def scatter_correlation(net_a, a: Observation, net_b, b: Observation) -> float:
-    """Correlation of the seed scatter of two different rows. Rows measured in one rig run (one
-    specimen: the same rig and the same conditions but the shear fraction) share it: two shear
-    points of one test with their net's `test_correlation`, two quantities of one run (a ring
-    shear's mu_ie_ps, mu_ie_s and bulk density; a hopper's flow rate, discharge time and bulk
+def scatter_correlations(obs: list[Observation], nets: list) -> np.ndarray:
+    """(n, n) correlation of the rows' seed scatter (nets: each row's net). Rows measured in one
+    rig run (one specimen: the same rig and the same conditions but the shear fraction) share it:
+    two shear points of one test with their net's `test_correlation`, two quantities of one run (a
+    ring shear's mu_ie_ps, mu_ie_s and bulk density; a hopper's flow rate, discharge time and bulk
     density) with the correlation the replicates measure (`run_correlation`). Rows of different
-    runs, and repeated rows of one quantity without a shear fraction (separate specimens), do not."""
-    if a.quantity.rig != b.quantity.rig or test_conditions(a) != test_conditions(b):
-        return 0.0
-    if net_a is net_b:
-        both_points = "shear_fraction" in a.conditions and "shear_fraction" in b.conditions
-        return getattr(net_a, "test_correlation", 0.0) if both_points else 0.0
-    return getattr(net_a, "run_correlation", {}).get(b.quantity.metric, 0.0)
+    runs do not. A test with repeated rows (two angles of repose, two flow rates at one slot:
+    repeats, separate runs) cannot say which rows shared a run: its rows are taken as independent
+    (pairing them all would also not be a valid correlation matrix)."""
+    n = len(obs)
+    c = np.eye(n)
+    tests: dict = {}
+    for i, o in enumerate(obs):
+        tests.setdefault((o.quantity.rig, test_conditions(o)), []).append(i)
+    for rows in tests.values():
+        points = [(obs[i].quantity, obs[i].conditions.get("shear_fraction")) for i in rows]
+        if len(set(points)) < len(points):
+            continue  # repeats: which rows came from one run is unknown
+        for i in rows:
+            for j in rows:
+                if i == j:
+                    continue
+                if nets[i] is nets[j]:  # two shear points of one test
+                    c[i, j] = getattr(nets[i], "test_correlation", 0.0)
+                else:
+                    c[i, j] = getattr(nets[i], "run_correlation", {}).get(obs[j].quantity.metric, 0.0)
+    return c
 
 
 def condition_correlation(net, a: Observation, b: Observation) -> float:

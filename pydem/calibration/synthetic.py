@@ -179,18 +179,18 @@ def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generat
                       truth_inputs: list | None = None) -> np.ndarray:
     """One draw of the rigs' seed scatter over a programme, as DEM runs make it: one run per test
     (a rig and its conditions but the shear fraction), whose rows share it as the likelihood says
-    (fit.scatter_correlation: the shear points of one test, the quantities of one run), and
+    (fit.scatter_correlations: the shear points of one test, the quantities of one run), and
     different tests are independent. Its size: the nets' error models at the truth's inputs
     where given."""
-    from .fit import scatter_correlation
+    from .fit import scatter_correlations
     out = np.zeros(len(obs))
+    rho = scatter_correlations(obs, [nets[o.quantity] for o in obs])
     tests: dict = {}
     for i, o in enumerate(obs):
         tests.setdefault((o.quantity.rig, test_conditions(o)), []).append(i)
     for rows in tests.values():
         sd = np.array([seed_sd_at(nets[obs[i].quantity], None if truth_inputs is None else truth_inputs[i]) for i in rows])
-        c = np.array([[1.0 if i == j else scatter_correlation(nets[obs[i].quantity], obs[i], nets[obs[j].quantity], obs[j])
-                       for j in rows] for i in rows])
+        c = rho[np.ix_(rows, rows)]
         w, v = np.linalg.eigh(c)  # a square root that tolerates a semi-definite c
         out[rows] = sd * (v @ (np.sqrt(np.clip(w, 0.0, None)) * rng.normal(size=len(rows))))
     return out

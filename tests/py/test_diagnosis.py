@@ -528,6 +528,13 @@ def test_the_rows_of_one_run_share_its_scatter_in_the_likelihood_and_in_syntheti
     assert abs(c[0, 1] + 0.6) < 0.05 and abs(c[2, 3] + 0.6) < 0.05, c
     assert abs(c[0, 2]) < 0.05 and abs(c[1, 3]) < 0.05, c
     assert draws.std(axis=0) == pytest.approx(s, rel=0.05)
+    # repeats at one slot (three flow rates, one discharge time: separate runs, which one shared
+    # the discharge time's run unknown) are independent; pairing all of them at -0.6 would not
+    # even be a valid covariance (3 * 0.36 > 1)
+    repeats = [Observation(qs[0], {"slot_width": 0.04}, 1.0, 0.0, "r")] * 3 + [Observation(qs[1], {"slot_width": 0.04}, 1.0, 0.0, "r")]
+    m = Model(repeats, nets, RANGES, CANDS)
+    assert np.allclose(m.cov, np.diag([0.02 ** 2] * 3 + [0.04 ** 2]), rtol=1e-12, atol=0)
+    assert np.isfinite(m.chi2(np.array([0.4, 0.5, 0.5]))[0])
 
 
 def test_a_log_output_quantity_net_has_the_gradient_of_exp():
