@@ -365,12 +365,14 @@ static dem_status build_pair_list(dem_domain *d, int64_t n)
     pair_list *pl = &d->pairs_cur;
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;
-    if (d->n_scan < nt) {
-        scan_buffer *grown = dem_realloc_array(d->scan, (size_t)nt, sizeof *grown);
+    /* a buffer for every thread the domain may use, not only the current team's (below) */
+    const int most = nt > d->def.num_threads ? nt : d->def.num_threads;
+    if (d->n_scan < most) {
+        scan_buffer *grown = dem_realloc_array(d->scan, (size_t)most, sizeof *grown);
         if (!grown) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");
-        memset(grown + d->n_scan, 0, (size_t)(nt - d->n_scan) * sizeof *grown);
+        memset(grown + d->n_scan, 0, (size_t)(most - d->n_scan) * sizeof *grown);
         d->scan = grown;
-        d->n_scan = nt;
+        d->n_scan = most;
     }
     scan_buffer *bufs = d->scan;
     for (int p = 0; p < nt; p++) bufs[p].count = bufs[p].failed = 0;
@@ -399,6 +401,13 @@ static dem_status build_pair_list(dem_domain *d, int64_t n)
         ok &= !bufs[p].failed;
     }
     ok = ok && pair_list_reserve(pl, count);
+    /* Every buffer can take the whole list: when the thread governor changes the team (one
+     * thread scanning every row, or a thread that scanned none joining), a warm step must not
+     * allocate (tests/c/test_no_alloc.c). A failed reserve is no error here: the scan grows a
+     * buffer when it needs to. */
+    for (int p = 0; ok && p < d->n_scan; p++)
+        while (bufs[p].cap < count && scan_buffer_grow(&bufs[p])) {
+        }
     if (ok) {
         start[0] = 0;
         for (int64_t i = 0; i < n; i++) start[i + 1] += start[i];
