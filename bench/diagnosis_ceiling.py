@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import sys
 import time
 from pathlib import Path
@@ -38,6 +37,7 @@ from scipy import stats
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import results_json  # noqa: E402
 from pydem.calibration import synthetic  # noqa: E402
 from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
 from pydem.calibration.surrogates import QuantityNet  # noqa: E402
@@ -79,24 +79,19 @@ def main() -> int:
     setup = load_setup([s for s in stores if s.exists()], say=lambda *a: None)
     if args.dem:
         return dem_ceiling(setup, args)
-    base_obs = synthetic.programme(setup.nets)
-    draw_kw = {} if args.floor is None else {"min_fraction": args.floor}
     t0 = time.perf_counter()
     rows = []
-    for c in setup.candidates:
-        for k in range(args.sets):
-            rng = np.random.default_rng([args.seed, sum(map(ord, c.name)), k])  # validate()'s draws
-            truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, c.name, **draw_kw)
-            obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, True)
-            s_nets = synthetic.signal(setup, truth, obs)
-            s_exact = without_net_error(lambda: synthetic.signal(setup, truth, obs))
-            one = c.side == "+"
-            rows.append({"effect": c.name, "set": k, "strength": truth.strength, "signal": s_nets,
-                         "signal_without_net_error": s_exact,
-                         "power": oracle_power(s_nets, one), "power_without_net_error": oracle_power(s_exact, one)})
-            print(f"  {c.name:14s} #{k:2d} strength {truth.strength:9.4g}  signal {s_nets:7.1f} "
-                  f"(exact nets {s_exact:7.1f})  oracle {rows[-1]['power']:.2f} / {rows[-1]['power_without_net_error']:.2f}",
-                  flush=True)
+    floor = 0.2 if args.floor is None else args.floor  # draw_truth's default: the protocol's
+    for c, k, truth, obs in synthetic.effect_sets(setup, args.sets, args.seed, min_fraction=floor):
+        s_nets = synthetic.signal(setup, truth, obs)
+        s_exact = without_net_error(lambda: synthetic.signal(setup, truth, obs))
+        one = c.side == "+"
+        rows.append({"effect": c.name, "set": k, "strength": truth.strength, "signal": s_nets,
+                     "signal_without_net_error": s_exact,
+                     "power": oracle_power(s_nets, one), "power_without_net_error": oracle_power(s_exact, one)})
+        print(f"  {c.name:14s} #{k:2d} strength {truth.strength:9.4g}  signal {s_nets:7.1f} "
+              f"(exact nets {s_exact:7.1f})  oracle {rows[-1]['power']:.2f} / {rows[-1]['power_without_net_error']:.2f}",
+              flush=True)
     table = {}
     for c in setup.candidates:
         r = [x for x in rows if x["effect"] == c.name]
@@ -105,22 +100,20 @@ def main() -> int:
                          "median_signal": float(np.median([x["signal"] for x in r])),
                          "median_signal_without_net_error": float(np.median([x["signal_without_net_error"] for x in r]))}
     label = args.label or (args.preset if args.floor is None else f"{args.preset}_floor{args.floor:g}")
-    out = ROOT / f"bench/results/diagnosis_ceiling_{label}.json"
-    meta = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{platform.machine()}, 2 cores",
-            "seconds": time.perf_counter() - t0, "alpha": ALPHA, "command": " ".join(sys.argv)}
-    out.write_text(json.dumps({"meta": meta, "table": table, "sets": rows}, indent=1))
+    out = results_json.write(f"diagnosis_ceiling_{label}", table, rows, t0)
     print(f"\nexpected top-1 of an oracle at alpha {ALPHA} ({args.sets} sets per effect):")
     for name, t in table.items():
         print(f"  {name:14s} with these nets {t['oracle_top1']:5.1f} ({t['oracle_top1'] / t['sets']:.0%})   "
               f"nets exact {t['oracle_top1_without_net_error']:5.1f} ({t['oracle_top1_without_net_error'] / t['sets']:.0%})   "
               f"median signal {t['median_signal']:.1f} / {t['median_signal_without_net_error']:.1f}")
-    print(f"-> {out} ({meta['seconds']:.0f} s)")
+    print(f"-> {out}")
     return 0
 
 
 def dem_ceiling(setup, args) -> int:
     """The oracle's expected top-1 on the DEM-made sets' truths, beside the loop's verdicts."""
     from pydem.calibration.quantities import Quantity
+    t0 = time.perf_counter()
     rows = []
     for journal in sorted((ROOT / "bench/results").glob("dem_sets_default*.jsonl")):
         diagnosed = journal.with_suffix(".diagnosed.json")
@@ -141,9 +134,7 @@ def dem_ceiling(setup, args) -> int:
     table = {c.name: {"sets": sum(r["effect"] == c.name for r in rows),
                       "oracle_top1": sum(r["power"] for r in rows if r["effect"] == c.name),
                       "loop_top1": sum(r["named"] for r in rows if r["effect"] == c.name)} for c in setup.candidates}
-    out = ROOT / f"bench/results/diagnosis_ceiling_{args.label or args.preset}_dem.json"
-    out.write_text(json.dumps({"meta": {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-                                        "command": " ".join(sys.argv)}, "table": table, "sets": rows}, indent=1))
+    out = results_json.write(f"diagnosis_ceiling_{args.label or args.preset}_dem", table, rows, t0)
     print(f"DEM-made sets: expected top-1 of an oracle at alpha {ALPHA} (signal on the surrogates) and the loop's:")
     for name, t in table.items():
         print(f"  {name:14s} {t['sets']} sets: oracle {t['oracle_top1']:.1f}, loop {t['loop_top1']}")

@@ -12,17 +12,15 @@ Writes bench/results/diagnosis_detectability_<preset>.json and prints the table.
 from __future__ import annotations
 
 import argparse
-import json
-import platform
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import results_json  # noqa: E402
 from pydem.calibration import synthetic  # noqa: E402
 from pydem.calibration.diagnose import diagnose  # noqa: E402
 from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
@@ -42,34 +40,26 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     setup = load_setup([s for s in (ROOT / p for p in shipped_stores(args.preset)) if s.exists()], say=lambda *a: None)
-    base_obs = synthetic.programme(setup.nets)
     t0 = time.perf_counter()
     rows = []
-    for c in setup.candidates:
-        for k in range(args.sets):
-            rng = np.random.default_rng([args.seed, sum(map(ord, c.name)), k])  # validate()'s draws
-            truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, c.name)
-            obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, True)
-            d = diagnose(f"{c.name}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
-            info = d.detectable[c.name]
-            rows.append({"effect": c.name, "set": k, "strength": truth.strength, "named": d.effect == c.name,
-                         "verdict": d.verdict, "detectable": info, "beyond": beyond(truth.strength, info)})
-            print(f"  {c.name:14s} #{k:2d} strength {truth.strength:9.4g}  limits {info.get('below')} / {info.get('above')}"
-                  f"  beyond {rows[-1]['beyond']!s:5s}  named {rows[-1]['named']}", flush=True)
+    for c, k, truth, obs in synthetic.effect_sets(setup, args.sets, args.seed):
+        d = diagnose(f"{c.name}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
+        info = d.detectable[c.name]
+        rows.append({"effect": c.name, "set": k, "strength": truth.strength, "named": d.effect == c.name,
+                     "verdict": d.verdict, "detectable": info, "beyond": beyond(truth.strength, info)})
+        print(f"  {c.name:14s} #{k:2d} strength {truth.strength:9.4g}  limits {info.get('below')} / {info.get('above')}"
+              f"  beyond {rows[-1]['beyond']!s:5s}  named {rows[-1]['named']}", flush=True)
     table = {}
     for c in setup.candidates:
         r = [x for x in rows if x["effect"] == c.name]
         out = [x for x in r if x["beyond"]]
         inn = [x for x in r if not x["beyond"]]
         table[c.name] = {"beyond": [sum(x["named"] for x in out), len(out)], "within": [sum(x["named"] for x in inn), len(inn)]}
-    out = ROOT / f"bench/results/diagnosis_detectability_{args.preset}.json"
-    meta = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "machine": f"{platform.machine()}, 2 cores",
-            "seconds": time.perf_counter() - t0, "command": " ".join(sys.argv)}
-    out.write_text(json.dumps({"meta": meta, "table": table, "sets": rows}, indent=1, default=float))
+    out = results_json.write(f"diagnosis_detectability_{args.preset}", table, rows, t0)
     print("\nnamed / sets, by whether the true effect lies beyond the smallest detectable one:")
     for name, t in table.items():
         print(f"  {name:14s} beyond {t['beyond'][0]}/{t['beyond'][1]}   within {t['within'][0]}/{t['within'][1]}")
-    print(f"-> {out} ({meta['seconds']:.0f} s)")
+    print(f"-> {out}")
     return 0
 
 

@@ -15,7 +15,6 @@ Writes bench/results/diagnosis_next_test_<preset>.json and prints the table."""
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -25,6 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import results_json  # noqa: E402
 from pydem.calibration import synthetic  # noqa: E402
 from pydem.calibration.detectability import candidate_tests  # noqa: E402
 from pydem.calibration.diagnose import diagnose  # noqa: E402
@@ -44,46 +44,38 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     setup = load_setup([s for s in (ROOT / p for p in shipped_stores(args.preset)) if s.exists()], say=lambda *a: None)
-    base_obs = synthetic.programme(setup.nets)
     quiet = {"say": lambda *a: None}
     t0 = time.perf_counter()
     rows = []
-    for c in setup.candidates:
-        for k in range(args.sets):
-            rng = np.random.default_rng([args.seed, sum(map(ord, c.name)), k])  # validate()'s draws
-            truth = synthetic.draw_truth(rng, setup.ranges, setup.candidates, c.name)
-            obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, True)
-            d = diagnose(f"{c.name}-{k}", obs, setup.nets, setup.ranges, setup.candidates, **quiet)
-            if d.effect == c.name:
+    for c, k, truth, obs in synthetic.effect_sets(setup, args.sets, args.seed):
+        d = diagnose(f"{c.name}-{k}", obs, setup.nets, setup.ranges, setup.candidates, **quiet)
+        if d.effect == c.name:
+            continue
+        tests = dict(candidate_tests(obs, setup.nets))
+        suggested = (d.detectable.get(c.name) or {}).get("measure_next")
+        extra_rng = np.random.default_rng([args.seed, 77, sum(map(ord, c.name)), k])
+        control = list(tests)[int(extra_rng.integers(len(tests)))]
+        row = {"effect": c.name, "set": k, "strength": truth.strength, "verdict": d.verdict,
+               "suggested": suggested and suggested["test"], "control": control}
+        for key, label in (("named_suggested", row["suggested"]), ("named_control", control)):
+            if label is None:
+                row[key] = None
                 continue
-            tests = dict(candidate_tests(obs, setup.nets))
-            suggested = (d.detectable.get(c.name) or {}).get("measure_next")
-            extra_rng = np.random.default_rng([args.seed, 77, sum(map(ord, c.name)), k])
-            control = list(tests)[int(extra_rng.integers(len(tests)))]
-            row = {"effect": c.name, "set": k, "strength": truth.strength, "verdict": d.verdict,
-                   "suggested": suggested and suggested["test"], "control": control}
-            for key, label in (("named_suggested", row["suggested"]), ("named_control", control)):
-                if label is None:
-                    row[key] = None
-                    continue
-                # the same draw for both tests' noise: only the test differs
-                more = with_test(setup, truth, obs, tests[label], np.random.default_rng([args.seed, 78, k]))
-                row[key] = diagnose(f"{c.name}-{k}+", more, setup.nets, setup.ranges, setup.candidates, **quiet).effect == c.name
-            rows.append(row)
-            print(f"  {c.name:14s} #{k:2d} {d.verdict:17s} + {row['suggested']}: {row['named_suggested']}   "
-                  f"+ {control}: {row['named_control']}", flush=True)
+            # the same draw for both tests' noise: only the test differs
+            more = with_test(setup, truth, obs, tests[label], np.random.default_rng([args.seed, 78, k]))
+            row[key] = diagnose(f"{c.name}-{k}+", more, setup.nets, setup.ranges, setup.candidates, **quiet).effect == c.name
+        rows.append(row)
+        print(f"  {c.name:14s} #{k:2d} {d.verdict:17s} + {row['suggested']}: {row['named_suggested']}   "
+              f"+ {control}: {row['named_control']}", flush=True)
     table = {c.name: {"missed": sum(r["effect"] == c.name for r in rows),
                       "named_with_suggested": sum(bool(r["named_suggested"]) for r in rows if r["effect"] == c.name),
                       "named_with_control": sum(bool(r["named_control"]) for r in rows if r["effect"] == c.name)}
              for c in setup.candidates}
-    out = ROOT / f"bench/results/diagnosis_next_test_{args.preset}.json"
-    meta = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seconds": time.perf_counter() - t0,
-            "command": " ".join(sys.argv)}
-    out.write_text(json.dumps({"meta": meta, "table": table, "sets": rows}, indent=1, default=float))
+    out = results_json.write(f"diagnosis_next_test_{args.preset}", table, rows, t0)
     print("\nof the sets whose effect was missed, named after one more test:")
     for name, t in table.items():
         print(f"  {name:14s} missed {t['missed']}: the suggested test {t['named_with_suggested']}, a random one {t['named_with_control']}")
-    print(f"-> {out} ({meta['seconds']:.0f} s)")
+    print(f"-> {out}")
     return 0
 
 

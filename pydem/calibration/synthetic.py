@@ -354,6 +354,24 @@ def score_sets(results: list[dict]) -> dict:
     return out
 
 
+def set_rng(seed: int, kind: str, k: int) -> np.random.Generator:
+    """The generator of set k of a kind: each set its own, so a resumed or partial run, and every
+    tool that revisits the validation's sets, draws the same ones."""
+    return np.random.default_rng([seed, sum(map(ord, kind)), k])
+
+
+def effect_sets(setup, n: int, seed: int = 0, net_error: bool = True, min_fraction: float = 0.2):
+    """(candidate, k, truth, observations) for n surrogate-made sets per candidate effect, drawn as
+    validate() draws them (the same seed gives the same sets)."""
+    base_obs = programme(setup.nets)
+    for c in setup.candidates:
+        for k in range(n):
+            rng = set_rng(seed, c.name, k)
+            truth = draw_truth(rng, setup.ranges, setup.candidates, c.name, min_fraction)
+            obs, _ = surrogate_set_and_means(setup.nets, setup.candidates, truth, rng, base_obs, net_error)
+            yield c, k, truth, obs
+
+
 def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surrogate", threads: int = 1,
              say=print, journal=None, net_error: bool = True) -> list[dict]:
     """Runs the protocol: kinds = {"null": n, <candidate name>: n, "unexplained": n}; source
@@ -372,7 +390,7 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
     for kind, n in kinds.items():
         for k in range(n):
             # each set its own seeded generator, so a resumed run draws the same sets
-            rng = np.random.default_rng([seed, sum(map(ord, kind)), k])
+            rng = set_rng(seed, kind, k)
             if (kind, k) in done:
                 rows.append(done[(kind, k)])
                 continue
