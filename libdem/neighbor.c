@@ -365,8 +365,9 @@ static dem_status build_pair_list(dem_domain *d, int64_t n)
     pair_list *pl = &d->pairs_cur;
     const pair_list *old = &d->pairs_old;
     const int64_t old_rows = old->start ? old->n_rows : 0;
-    /* a buffer for every thread the domain may use, not only the current team's (below) */
-    const int most = nt > d->def.num_threads ? nt : d->def.num_threads;
+    /* a buffer for every thread the domain may use (the team is at most num_threads), not only
+     * the current team's (below) */
+    const int most = d->def.num_threads;
     if (d->n_scan < most) {
         scan_buffer *grown = dem_realloc_array(d->scan, (size_t)most, sizeof *grown);
         if (!grown) return dem_fail(d, DEM_ERR_NO_MEMORY, "neighbour build: out of memory");

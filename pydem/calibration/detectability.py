@@ -83,9 +83,7 @@ def information(model: Model, p: np.ndarray, parameter: str) -> float:
     """|M^1/2 J_E|^2 at the base parameters p: how strongly the rows tell a small step of the
     candidate's input from what the base parameters can re-adjust (the score test's information;
     the signal of a small effect eta is (eta - neutral)^2 times this)."""
-    jt = model.white(model.jacobian(p))
-    je = model.white(model.net_jacobian(p, parameter))
-    mje = je - jt @ np.linalg.solve(jt.T @ jt + 1e-12 * np.eye(jt.shape[1]), jt.T @ je)
+    mje = model.projected_signature(p, parameter)
     return float(mje @ mje)
 
 

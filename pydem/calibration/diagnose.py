@@ -120,10 +120,7 @@ def _score(model: Model, fit: Fit, parameter: str) -> tuple[float, float, np.nda
     """(S, implied step, M J_E) of the score test for one net input at the base fit, in whitened
     units: M projects out what the base parameters can re-adjust."""
     r = model.white(model.y - model.predict(fit.best))
-    jt = model.white(model.jacobian(fit.best))
-    je = model.white(model.net_jacobian(fit.best, parameter))
-    a = jt.T @ jt + 1e-12 * np.eye(jt.shape[1])
-    mje = je - jt @ np.linalg.solve(a, jt.T @ je)
+    mje = model.projected_signature(fit.best, parameter)
     info = float(mje @ mje)
     u = float(mje @ r)  # J_E' M r: the score with the base parameters re-adjusted
     if info <= 0:

@@ -155,6 +155,14 @@ class Model:
             out.append(g[net.input_names.index(parameter)] if parameter in net.input_names else 0.0)
         return np.array(out)
 
+    def projected_signature(self, p: np.ndarray, parameter: str) -> np.ndarray:
+        """M^1/2 J_E at p, whitened: the rows' response to a small step of the net input
+        `parameter` less what the free parameters can re-adjust (the score test's signature; its
+        squared norm is the test's information)."""
+        jt = self.white(self.jacobian(p))
+        je = self.white(self.net_jacobian(p, parameter))
+        return je - jt @ np.linalg.solve(jt.T @ jt + 1e-12 * np.eye(jt.shape[1]), jt.T @ je)
+
     def residuals(self, p):
         return self.white(self.y - self.predict(p))
 
@@ -163,8 +171,9 @@ class Model:
         return np.sum(r * r, axis=1)
 
 
-def scatter_correlations(obs: list[Observation], nets: list) -> np.ndarray:
-    """(n, n) correlation of the rows' seed scatter (nets: each row's net). Rows measured in one
+def scatter_correlations(obs: list[Observation], nets: list, run_rho: dict | None = None) -> np.ndarray:
+    """(n, n) correlation of the rows' seed scatter (nets: each row's net; run_rho: {(metric,
+    metric): rho} in place of the nets' `run_correlation`, for a trial set). Rows measured in one
     rig run (one specimen: the same rig and the same conditions but the shear fraction) share it:
     two shear points of one test with their net's `test_correlation`, two quantities of one run (a
     ring shear's mu_ie_ps, mu_ie_s and bulk density; a hopper's flow rate, discharge time and bulk
@@ -187,6 +196,8 @@ def scatter_correlations(obs: list[Observation], nets: list) -> np.ndarray:
                     continue
                 if nets[i] is nets[j]:  # two shear points of one test
                     c[i, j] = getattr(nets[i], "test_correlation", 0.0)
+                elif run_rho is not None:
+                    c[i, j] = run_rho.get((obs[i].quantity.metric, obs[j].quantity.metric), 0.0)
                 else:
                     c[i, j] = getattr(nets[i], "run_correlation", {}).get(obs[j].quantity.metric, 0.0)
     return c

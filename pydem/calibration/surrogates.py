@@ -351,13 +351,15 @@ def run_correlations(reps, metrics: list[str]) -> dict[tuple[str, str], float]:
 def one_run_correlation(nets: list[QuantityNet], rho: dict[tuple[str, str], float]) -> np.ndarray:
     """The seed scatter's correlation matrix over the rows of one run (each quantity once, a
     quantity with a shear fraction at three points), with the cross-quantity terms `rho`."""
-    rows = [n for n in nets for _ in range(3 if "shear_fraction" in n.input_names else 1)]
-    c = np.eye(len(rows))
-    for i, a in enumerate(rows):
-        for j, b in enumerate(rows):
-            if i != j:
-                c[i, j] = a.test_correlation if a is b else rho.get((a.quantity.metric, b.quantity.metric), 0.0)
-    return c
+    from .fit import scatter_correlations
+    from .quantities import Observation
+    row_nets = [n for n in nets for _ in range(3 if "shear_fraction" in n.input_names else 1)]
+    rows, seen = [], {}
+    for n in row_nets:  # one test: no condition but the shear fraction, which tells its points apart
+        k = seen[id(n)] = seen.get(id(n), -1) + 1
+        rows.append(Observation(n.quantity, {"shear_fraction": 0.3 * (k + 1)} if "shear_fraction" in n.input_names else {},
+                                1.0, 0.0, n.quantity.key))
+    return scatter_correlations(rows, row_nets, rho)
 
 
 def attach_run_correlations(nets: list[QuantityNet], reps, say=print) -> None:
