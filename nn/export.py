@@ -30,8 +30,9 @@ import numpy as np
 @dataclass
 class NetArrays:
     """What an exported net is: a name, its inputs with their scaling box, the output scaling
-    and the weights of one tanh hidden layer. Made from a trained PropertyNet (torch) or from
-    a cached surrogate (pydem.calibration.surrogates.QuantityNet, numpy): export needs no torch."""
+    and the weights of one tanh hidden layer; evaluated in numpy as libdem evaluates it. Made from
+    a trained PropertyNet (torch), or held by a cached surrogate (pydem.calibration.surrogates.
+    QuantityNet): export and evaluation need no torch."""
     name: str
     unit: str
     input_names: list[str]
@@ -48,6 +49,24 @@ class NetArrays:
     @property
     def hidden(self) -> int:
         return int(len(self.b1))
+
+    def scaled(self, x: np.ndarray, clip: bool = False) -> np.ndarray:
+        """Inputs mapped to the net's [-1, 1] box (clip: held inside it)."""
+        s = (np.atleast_2d(x) - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
+        return np.clip(s, -1.0, 1.0) if clip else s
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """x: (m, inputs) -> (m,): what libdem's dem_mlp routine computes, in numpy."""
+        h = np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+        y = (h @ self.w2 + self.b2 + 1.0) * (0.5 * (self.y_hi - self.y_lo)) + self.y_lo
+        return np.exp(y) if self.log_output else y
+
+    def gradient(self, x: np.ndarray) -> np.ndarray:
+        """x: (m, inputs) -> (m, inputs): d f / d x (one hidden layer: analytic)."""
+        h = np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+        g = ((1.0 - h * h) * self.w2) @ self.w1  # d y_s / d s
+        g = g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
+        return g * self(x)[:, None] if self.log_output else g
 
 
 def _hex(values) -> str:

@@ -27,7 +27,7 @@ def export_nets(nets: dict, directory: Path) -> list[Path]:
     directory.mkdir(parents=True, exist_ok=True)
     out = []
     for net in nets.values():
-        a = net.export_arrays()
+        a = net.mlp
         out.append(write_weights(a, directory / f"{net.name}.mlp"))
         write_c(a, directory / "c")
     return out

@@ -127,7 +127,7 @@ def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, th
     natives = {}
     for k, net in enumerate(model.nets):
         if id(net) not in natives:  # a net that cannot be exported (a test's closed form) runs in numpy
-            natives[id(net)] = (NativeMLP(text=weights_text(net.export_arrays())) if hasattr(net, "export_arrays")
+            natives[id(net)] = (NativeMLP(text=weights_text(net.mlp)) if hasattr(net, "mlp")
                                 else lambda x, _threads, net=net: net(x))
         pred = natives[id(net)](model.row_inputs(k, pts), threads)
         keep &= np.abs(pred - model.y[k]) <= window * abs(model.y[k])

@@ -25,10 +25,12 @@ import hashlib
 import json
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+
+from nn.export import NetArrays, arrays_of
 
 from .quantities import Quantity, counted_runs, fraction_columns, training_tables
 
@@ -42,26 +44,16 @@ ERROR_SPAN = 5.0  # the error model's sd stays within [RMSE / 5, RMSE * 5]
 @dataclass
 class QuantityNet:
     quantity: Quantity
-    input_names: list[str]
-    lo: np.ndarray          # input scaling: [lo, hi] -> [-1, 1]
-    hi: np.ndarray
-    y_lo: float
-    y_hi: float
-    w1: np.ndarray          # hidden x inputs
-    b1: np.ndarray
-    w2: np.ndarray          # hidden
-    b2: float
+    mlp: NetArrays          # the net itself: inputs, their scaling box, weights (what libdem's routine loads)
     rmse: float             # cross-validated RMSE against single runs (scatter + net error)
     r2: float               # cross-validated R^2
     runs: int
-    unit: str = ""
     scatter: float = float("nan")  # seed-to-seed sd of one run, from replicate runs (nan: unknown)
     test_correlation: float = 0.0  # correlation of one run's errors at its several points (shear points)
     # where the error is: log sd of one run about the net = err_c0 + err_c . (scaled inputs), fitted
     # to the cross-validated residuals (fit_error_model); None: the RMSE everywhere
     err_c0: float = float("nan")
     err_c: np.ndarray | None = None
-    log_output: bool = False  # the net learnt log(value) (a positive quantity): f = exp(scaled output)
     # the seed scatter where the error model is: a fixed fraction of the total sd at a point, when the
     # replicates say so (fit_scatter_ratio); nan: the pooled `scatter` everywhere
     scatter_ratio: float = float("nan")
@@ -112,43 +104,35 @@ class QuantityNet:
             seed = np.minimum(self.scatter, t) if np.isfinite(self.scatter) else t
         return seed, np.sqrt(np.maximum(t * t - seed * seed, (0.2 * t) ** 2))
 
-    def scaled(self, x: np.ndarray, clip: bool = False) -> np.ndarray:
-        """Inputs mapped to the net's [-1, 1] box (clip: held inside it, for the error model)."""
-        s = (np.atleast_2d(x) - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
-        return np.clip(s, -1.0, 1.0) if clip else s
+    # the net's inputs and output as the rest of the chain asks for them
+    input_names = property(lambda self: self.mlp.input_names)
+    lo = property(lambda self: self.mlp.lo)
+    hi = property(lambda self: self.mlp.hi)
+    unit = property(lambda self: self.mlp.unit)
+    log_output = property(lambda self: self.mlp.log_output)  # learnt log(value): f = exp(scaled output)
 
-    def _hidden(self, x: np.ndarray):
-        return np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+    def scaled(self, x: np.ndarray, clip: bool = False) -> np.ndarray:
+        return self.mlp.scaled(x, clip)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """x: (m, inputs) -> (m,)"""
-        h = self._hidden(np.atleast_2d(x))
-        y = (h @ self.w2 + self.b2 + 1.0) * (0.5 * (self.y_hi - self.y_lo)) + self.y_lo
-        return np.exp(y) if self.log_output else y
+        return self.mlp(x)
 
     def gradient(self, x: np.ndarray) -> np.ndarray:
         """x: (m, inputs) -> (m, inputs): d f / d x."""
-        h = self._hidden(np.atleast_2d(x))
-        g = ((1.0 - h * h) * self.w2) @ self.w1  # d y_s / d s
-        g = g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
-        return g * self(x)[:, None] if self.log_output else g
+        return self.mlp.gradient(x)
 
     @property
     def name(self) -> str:
         """File and C name: ring_shear__mu_ie_s."""
-        return f"{self.quantity.rig.replace('-', '_')}__{self.quantity.metric}"
-
-    def export_arrays(self):
-        """The net as nn.export.NetArrays (weights file for libdem, standalone C)."""
-        from nn.export import NetArrays
-        return NetArrays(self.name, self.unit, list(self.input_names), self.lo, self.hi, self.y_lo, self.y_hi,
-                         self.w1, self.b1, self.w2, self.b2, self.log_output)
+        return net_name(self.quantity)
 
     def to_arrays(self) -> dict:
-        return {"lo": self.lo, "hi": self.hi, "w1": self.w1, "b1": self.b1, "w2": self.w2,
+        m = self.mlp
+        return {"lo": m.lo, "hi": m.hi, "w1": m.w1, "b1": m.b1, "w2": m.w2,
                 "meta": np.array(json.dumps({"rig": self.quantity.rig, "metric": self.quantity.metric,
-                                             "inputs": self.input_names, "y_lo": self.y_lo, "y_hi": self.y_hi,
-                                             "b2": self.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
+                                             "inputs": m.input_names, "y_lo": m.y_lo, "y_hi": m.y_hi,
+                                             "b2": m.b2, "rmse": self.rmse, "r2": self.r2, "runs": self.runs,
                                              "unit": self.unit, "scatter": self.scatter,
                                              "test_correlation": self.test_correlation, "err_c0": self.err_c0,
                                              "log_output": self.log_output, "scatter_ratio": self.scatter_ratio,
@@ -158,11 +142,18 @@ class QuantityNet:
     @classmethod
     def from_arrays(cls, a) -> "QuantityNet":
         meta = json.loads(str(a["meta"]))
-        return cls(Quantity(meta["rig"], meta["metric"]), meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
-                   a["w1"], a["b1"], a["w2"], meta["b2"], meta["rmse"], meta["r2"], meta["runs"], meta["unit"],
+        q = Quantity(meta["rig"], meta["metric"])
+        mlp = NetArrays(net_name(q), meta["unit"], meta["inputs"], a["lo"], a["hi"], meta["y_lo"], meta["y_hi"],
+                        a["w1"], a["b1"], a["w2"], meta["b2"], meta.get("log_output", False))
+        return cls(q, mlp, meta["rmse"], meta["r2"], meta["runs"],
                    meta.get("scatter", float("nan")), meta.get("test_correlation", 0.0), meta.get("err_c0", float("nan")),
-                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None, meta.get("log_output", False),
+                   np.array(a["err_c"]) if "err_c" in getattr(a, "files", a) else None,
                    meta.get("scatter_ratio", float("nan")))
+
+
+def net_name(q: Quantity) -> str:
+    """A quantity's net as a file and C name: ring_shear__mu_ie_s."""
+    return f"{q.rig.replace('-', '_')}__{q.metric}"
 
 
 def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prior_sd: float = 0.5):
@@ -447,12 +438,8 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
             if cv_log["rmse"] < cv["rmse"]:
                 cv, log_target = cv_log, True
         net = bagged_net(q.key, names, x, y, h, BAG, seed=0, unit=unit, log_target=log_target)
-        lin1, lin2 = net.model.hidden, net.model.out
-        nets[q] = QuantityNet(q, list(names), net.x_scaler.lo.copy(), net.x_scaler.hi.copy(), float(net.y_scaler.lo[0]),
-                              float(net.y_scaler.hi[0]), lin1.weight.detach().numpy().copy(),
-                              lin1.bias.detach().numpy().copy(), lin2.weight.detach().numpy()[0].copy(),
-                              float(lin2.bias.detach().numpy()[0]), cv["rmse"], cv["r2"], int(len(y)), unit,
-                              log_output=log_target)
+        mlp = replace(arrays_of(net), name=net_name(q), input_names=list(names))
+        nets[q] = QuantityNet(q, mlp, cv["rmse"], cv["r2"], int(len(y)))
         fit_error_model(nets[q], x, y - cv["predicted"])
         sd = nets[q].total_sd(x)
         say(f"  {q.key:28s} {len(y):4d} rows  {BAG} x {h:2d} hidden{' log' if log_target else ''}  {FOLDS}-fold CV R^2 {cv['r2']:.3f}  "

@@ -1,6 +1,7 @@
 """The diagnosis loop (pydem.calibration) against closed forms on a linear world, where the
 score test, the profile-likelihood ratio and the Laplace posterior are exact, then on the
 shipped tiny stores end to end (`pydem diagnose`, report and JSON)."""
+import dataclasses
 import json
 import math
 import subprocess
@@ -9,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 
+from nn.export import NetArrays
 from pydem.calibration import diagnose as dg
 from pydem.calibration.candidates import Candidate
 from pydem.calibration.fit import Model, minimise, posterior
@@ -21,6 +23,12 @@ CANDS = [Candidate("a", "eta_a", "", lambda th: 0.0, "+", "no a"),
          Candidate("b", "eta_b", "", lambda th: 0.0, "+-", "no b")]
 INPUTS = ["friction", "rolling_friction", "restitution", "eta_a", "eta_b", "condition"]
 
+
+
+def zero_mlp(names: list[str]) -> NetArrays:
+    """A net over `names` on the unit box with no weights: a constant (for the error-model tests)."""
+    k = len(names)
+    return NetArrays("t", "", list(names), np.zeros(k), np.ones(k), 0.0, 1.0, np.zeros((1, k)), np.zeros(1), np.zeros(1), 0.0)
 
 class LinearNet:
     """f = c0 + sum_i (a_i + b_i c) p_i over the five parameters p, c the condition: linear in
@@ -392,8 +400,7 @@ def test_the_error_model_finds_where_the_error_is_and_splits_it():
     from pydem.calibration.quantities import Quantity
     from pydem.calibration.surrogates import QuantityNet, fit_error_model
     rng = np.random.default_rng(8)
-    net = QuantityNet(Quantity("aor", "angle_of_repose"), ["a", "b"], np.zeros(2), np.ones(2), 0.0, 1.0,
-                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.15, r2=0.5, runs=3000)
+    net = QuantityNet(Quantity("aor", "angle_of_repose"), zero_mlp(["a", "b"]), rmse=0.15, r2=0.5, runs=3000)
     x = rng.uniform(0, 1, (3000, 2))
     s0 = 2 * x[:, 0] - 1
     r = 0.1 * np.exp(0.8 * s0) * rng.normal(size=3000)
@@ -416,8 +423,7 @@ def test_the_seed_scatter_follows_the_error_model_when_the_replicates_do():
     from pydem.calibration.quantities import Quantity
     from pydem.calibration.surrogates import QuantityNet, fit_scatter_ratio
     rng = np.random.default_rng(9)
-    net = QuantityNet(Quantity("aor", "angle_of_repose"), ["a", "b"], np.zeros(2), np.ones(2), 0.0, 1.0,
-                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.15, r2=0.5, runs=300,
+    net = QuantityNet(Quantity("aor", "angle_of_repose"), zero_mlp(["a", "b"]), rmse=0.15, r2=0.5, runs=300,
                       err_c0=np.log(0.1), err_c=np.array([1.0, 0.0]))
     x = rng.uniform(0, 1, (60, 2))
     t = net.total_sd(x)
@@ -444,8 +450,7 @@ def test_the_specimen_correlation_comes_from_the_replicates():
     from pydem.calibration.surrogates import QuantityNet, test_correlation
     rng = np.random.default_rng(10)
     names = ["mu_ie_s_30", "mu_ie_s_60", "mu_ie_s_90"]
-    net = QuantityNet(Quantity("ring-shear", "mu_ie_s"), ["a", "shear_fraction"], np.zeros(2), np.ones(2), 0.0, 1.0,
-                      np.zeros((1, 2)), np.zeros(1), np.zeros(1), 0.0, rmse=0.1, r2=0.5, runs=100)
+    net = QuantityNet(Quantity("ring-shear", "mu_ie_s"), zero_mlp(["a", "shear_fraction"]), rmse=0.1, r2=0.5, runs=100)
     store = SimpleNamespace(metric_names=names)
     for rho in (0.6, 0.0):
         cov = np.full((3, 3), rho) + (1 - rho) * np.eye(3)
@@ -486,8 +491,7 @@ def test_pairwise_run_correlations_are_made_a_valid_matrix():
     from pydem.calibration import surrogates
     from pydem.calibration.surrogates import QuantityNet, attach_run_correlations, one_run_correlation
     metrics = ["mass_flow_rate", "discharge_time", "bulk_density"]
-    nets = [QuantityNet(Quantity("hopper", m), ["a"], np.zeros(1), np.ones(1), 0.0, 1.0, np.zeros((1, 1)), np.zeros(1),
-                        np.zeros(1), 0.0, rmse=0.1, r2=0.5, runs=100) for m in metrics]
+    nets = [QuantityNet(Quantity("hopper", m), zero_mlp(["a"]), rmse=0.1, r2=0.5, runs=100) for m in metrics]
     for r, kept in ((-0.9, False), (-0.3, True)):
         pairs = {(a, b): r for a in metrics for b in metrics if a != b}
         original = surrogates.run_correlations
@@ -543,11 +547,11 @@ def test_a_log_output_quantity_net_has_the_gradient_of_exp():
     from pydem.calibration.quantities import Quantity
     from pydem.calibration.surrogates import QuantityNet
     rng = np.random.default_rng(2)
-    net = QuantityNet(Quantity("hopper", "discharge_time"), ["a", "b"], np.zeros(2), np.array([1.0, 2.0]),
-                      -1.0, 1.0, rng.normal(size=(4, 2)), rng.normal(size=4), rng.normal(size=4), 0.1,
-                      rmse=0.1, r2=0.9, runs=100, log_output=True)
+    mlp = NetArrays("t", "s", ["a", "b"], np.zeros(2), np.array([1.0, 2.0]), -1.0, 1.0, rng.normal(size=(4, 2)),
+                    rng.normal(size=4), rng.normal(size=4), 0.1, log_output=True)
+    net = QuantityNet(Quantity("hopper", "discharge_time"), mlp, rmse=0.1, r2=0.9, runs=100)
     x = rng.uniform(0.1, 0.9, (5, 2)) * np.array([1.0, 2.0])
-    lin = QuantityNet(**{**net.__dict__, "log_output": False})
+    lin = dataclasses.replace(net, mlp=dataclasses.replace(mlp, log_output=False))
     np.testing.assert_allclose(net(x), np.exp(lin(x)), rtol=1e-14)
     h = 1e-6
     for j in range(2):
