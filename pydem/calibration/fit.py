@@ -263,7 +263,8 @@ def minimise(model: Model, starts: int = 4096, keep: int = 6, seed: int = 0, sta
         res = optimize.least_squares(lambda u: model.residuals(model.lo + u * width), (pts[i] - model.lo) / width,
                                      jac=lambda u: -model.white(model.jacobian(model.lo + u * width)) * width,
                                      bounds=(0.0, 1.0), method="trf", x_scale=1.0, max_nfev=200)
-        p = model.lo + res.x * width
+        u = np.where(res.x < 1e-10, 0.0, np.where(res.x > 1.0 - 1e-10, 1.0, res.x))  # on a bound, exactly (not 4e-18)
+        p = model.lo + u * width
         c = float(model.chi2(p)[0])
         if c < best_c:
             best_p, best_c = p, c
