@@ -100,14 +100,12 @@ def main() -> int:
                          "median_signal": float(np.median([x["signal"] for x in r])),
                          "median_signal_without_net_error": float(np.median([x["signal_without_net_error"] for x in r]))}
     label = args.label or (args.preset if args.floor is None else f"{args.preset}_floor{args.floor:g}")
-    out = results_json.write(f"diagnosis_ceiling_{label}", table, rows, t0)
-    print(f"\nexpected top-1 of an oracle at alpha {ALPHA} ({args.sets} sets per effect):")
-    for name, t in table.items():
-        print(f"  {name:14s} with these nets {t['oracle_top1']:5.1f} ({t['oracle_top1'] / t['sets']:.0%})   "
-              f"nets exact {t['oracle_top1_without_net_error']:5.1f} ({t['oracle_top1_without_net_error'] / t['sets']:.0%})   "
-              f"median signal {t['median_signal']:.1f} / {t['median_signal_without_net_error']:.1f}")
-    print(f"-> {out}")
-    return 0
+    return results_json.report(
+        f"diagnosis_ceiling_{label}", table, rows, t0,
+        f"\nexpected top-1 of an oracle at alpha {ALPHA} ({args.sets} sets per effect):",
+        lambda _, t: f"with these nets {t['oracle_top1']:5.1f} ({t['oracle_top1'] / t['sets']:.0%})   "
+                     f"nets exact {t['oracle_top1_without_net_error']:5.1f} ({t['oracle_top1_without_net_error'] / t['sets']:.0%})   "
+                     f"median signal {t['median_signal']:.1f} / {t['median_signal_without_net_error']:.1f}")
 
 
 def dem_ceiling(setup, args) -> int:
@@ -134,12 +132,10 @@ def dem_ceiling(setup, args) -> int:
     table = {c.name: {"sets": sum(r["effect"] == c.name for r in rows),
                       "oracle_top1": sum(r["power"] for r in rows if r["effect"] == c.name),
                       "loop_top1": sum(r["named"] for r in rows if r["effect"] == c.name)} for c in setup.candidates}
-    out = results_json.write(f"diagnosis_ceiling_{args.label or args.preset}_dem", table, rows, t0)
-    print(f"DEM-made sets: expected top-1 of an oracle at alpha {ALPHA} (signal on the surrogates) and the loop's:")
-    for name, t in table.items():
-        print(f"  {name:14s} {t['sets']} sets: oracle {t['oracle_top1']:.1f}, loop {t['loop_top1']}")
-    print(f"-> {out}")
-    return 0
+    return results_json.report(
+        f"diagnosis_ceiling_{args.label or args.preset}_dem", table, rows, t0,
+        f"DEM-made sets: expected top-1 of an oracle at alpha {ALPHA} (signal on the surrogates) and the loop's:",
+        lambda _, t: f"{t['sets']} sets: oracle {t['oracle_top1']:.1f}, loop {t['loop_top1']}")
 
 
 if __name__ == "__main__":

@@ -55,12 +55,10 @@ def main() -> int:
         out = [x for x in r if x["beyond"]]
         inn = [x for x in r if not x["beyond"]]
         table[c.name] = {"beyond": [sum(x["named"] for x in out), len(out)], "within": [sum(x["named"] for x in inn), len(inn)]}
-    out = results_json.write(f"diagnosis_detectability_{args.preset}", table, rows, t0)
-    print("\nnamed / sets, by whether the true effect lies beyond the smallest detectable one:")
-    for name, t in table.items():
-        print(f"  {name:14s} beyond {t['beyond'][0]}/{t['beyond'][1]}   within {t['within'][0]}/{t['within'][1]}")
-    print(f"-> {out}")
-    return 0
+    return results_json.report(
+        f"diagnosis_detectability_{args.preset}", table, rows, t0,
+        "\nnamed / sets, by whether the true effect lies beyond the smallest detectable one:",
+        lambda _, t: f"beyond {t['beyond'][0]}/{t['beyond'][1]}   within {t['within'][0]}/{t['within'][1]}")
 
 
 if __name__ == "__main__":

@@ -71,12 +71,11 @@ def main() -> int:
                       "named_with_suggested": sum(bool(r["named_suggested"]) for r in rows if r["effect"] == c.name),
                       "named_with_control": sum(bool(r["named_control"]) for r in rows if r["effect"] == c.name)}
              for c in setup.candidates}
-    out = results_json.write(f"diagnosis_next_test_{args.preset}", table, rows, t0)
-    print("\nof the sets whose effect was missed, named after one more test:")
-    for name, t in table.items():
-        print(f"  {name:14s} missed {t['missed']}: the suggested test {t['named_with_suggested']}, a random one {t['named_with_control']}")
-    print(f"-> {out}")
-    return 0
+    return results_json.report(
+        f"diagnosis_next_test_{args.preset}", table, rows, t0,
+        "\nof the sets whose effect was missed, named after one more test:",
+        lambda _, t: f"missed {t['missed']}: the suggested test {t['named_with_suggested']}, "
+                     f"a random one {t['named_with_control']}")
 
 
 if __name__ == "__main__":

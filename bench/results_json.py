@@ -8,6 +8,7 @@ import platform
 import sys
 import time
 from pathlib import Path
+from typing import Callable
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -20,3 +21,14 @@ def write(name: str, table: dict, sets: list, started: float) -> Path:
     out = RESULTS / f"{name}.json"
     out.write_text(json.dumps({"meta": meta, "table": table, "sets": sets}, indent=1, default=float))
     return out
+
+
+def report(name: str, table: dict, sets: list, started: float, heading: str, line: Callable[[str, dict], str]) -> int:
+    """write(), then the table on the terminal: the heading, line(effect, row) per effect, the path.
+    Returns 0 (a bench's exit status)."""
+    out = write(name, table, sets, started)
+    print(heading)
+    for effect, row in table.items():
+        print(f"  {effect:14s} {line(effect, row)}")
+    print(f"-> {out}")
+    return 0
