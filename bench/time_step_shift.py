@@ -30,15 +30,18 @@ SHIPPED = common.stable_dt
 def run(rig: str, seed: int, steps_per_contact: int | None) -> tuple[dict, float, float]:
     """(metrics, CPU seconds, dt) of one `default` run, one thread; steps_per_contact None: as shipped."""
     cls, cfg_cls = RIGS[rig]
-    module = __import__(cls.__module__, fromlist=["stable_dt"])
-    module.stable_dt = SHIPPED if steps_per_contact is None else (
-        lambda d, impact_speed=0.5, fraction=0.2, steps=25: SHIPPED(d, impact_speed, fraction, steps_per_contact))
+    module = __import__(cls.__module__, fromlist=["stable_dt"])  # the rig's own name for stable_dt
+    if steps_per_contact is not None:
+        module.stable_dt = lambda d, impact_speed=0.5, fraction=0.2, steps=25: SHIPPED(d, impact_speed, fraction,
+                                                                                       steps_per_contact)
     cfg = cfg_cls.preset("default")
     cfg.num_threads = 1
     c0 = resource.getrusage(resource.RUSAGE_SELF).ru_utime
-    res = cls(cfg).run(params=CENTRE, seed=seed)
+    try:
+        res = cls(cfg).run(params=CENTRE, seed=seed)
+    finally:
+        module.stable_dt = SHIPPED
     cpu = resource.getrusage(resource.RUSAGE_SELF).ru_utime - c0
-    module.stable_dt = SHIPPED
     return {k: float(getattr(m, "value", m)) for k, m in res.metrics.items()}, cpu, float(res.info["dt"])
 
 

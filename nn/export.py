@@ -55,18 +55,23 @@ class NetArrays:
         s = (np.atleast_2d(x) - self.lo) * (2.0 / (self.hi - self.lo)) - 1.0
         return np.clip(s, -1.0, 1.0) if clip else s
 
-    def __call__(self, x: np.ndarray) -> np.ndarray:
-        """x: (m, inputs) -> (m,): what libdem's dem_mlp routine computes, in numpy."""
-        h = np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+    def _hidden(self, x: np.ndarray) -> np.ndarray:
+        return np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+
+    def _output(self, h: np.ndarray) -> np.ndarray:
         y = (h @ self.w2 + self.b2 + 1.0) * (0.5 * (self.y_hi - self.y_lo)) + self.y_lo
         return np.exp(y) if self.log_output else y
 
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """x: (m, inputs) -> (m,): what libdem's dem_mlp routine computes, in numpy."""
+        return self._output(self._hidden(x))
+
     def gradient(self, x: np.ndarray) -> np.ndarray:
-        """x: (m, inputs) -> (m, inputs): d f / d x (one hidden layer: analytic)."""
-        h = np.tanh(self.scaled(x) @ self.w1.T + self.b1)
+        """x: (m, inputs) -> (m, inputs): d f / d x (one hidden layer: analytic; one forward pass)."""
+        h = self._hidden(x)
         g = ((1.0 - h * h) * self.w2) @ self.w1  # d y_s / d s
         g = g * (2.0 / (self.hi - self.lo)) * (0.5 * (self.y_hi - self.y_lo))
-        return g * self(x)[:, None] if self.log_output else g
+        return g * self._output(h)[:, None] if self.log_output else g
 
 
 def _hex(values) -> str:
