@@ -2,8 +2,8 @@
 beside the physics baselines.
 
 - `load_frames`: every stored frame of the chosen cases as float32 (n, 1, size, size) in [0, 1]
-  (area-averaged from the stored 224 x 224 crop when size < 224) with its case, time,
-  remaining discharge time and NRRP;
+  (area-averaged from the stored 224 x 224 crop when size < 224), or its two species as two
+  channels (`species_frames`), with its case, time, remaining discharge time and NRRP;
 - splits: `random_split` (seed 001's 60/20/20 over frames: neighbouring frames of one run are
   near-duplicates, so it flatters) and `case_split` (whole cases held out: what a user predicting
   a new hopper gets);
@@ -15,8 +15,8 @@ beside the physics baselines.
   from the empty end);
 - baselines: Beverloo's slot law for a case's discharge time (C and k fitted on training cases
   only) and, per frame, the remaining time as the frame's fill fraction times it; a constant-rate
-  extrapolation of the first 20 % of NRRP(t), and the NRRP as a fill-level gauge calibrated on
-  training cases reads it."""
+  extrapolation of the first 20 % of NRRP(t), and the NRRP as two image gauges calibrated on
+  training cases read it: from the frame's fill level, and from each species' visible fill."""
 from __future__ import annotations
 
 import contextlib
@@ -52,7 +52,7 @@ def _autocast(device: torch.device):
 
 @dataclass
 class Frames:
-    x: np.ndarray          # (n, 1, size, size) float32 in [0, 1]
+    x: np.ndarray          # (n, channels, size, size) float32 in [0, 1]
     case: np.ndarray       # (n,) case names
     time: np.ndarray       # s since the gate opened
     remaining: np.ndarray  # remaining discharge time (s)
@@ -73,16 +73,36 @@ def shrink(frames: np.ndarray, size: int) -> np.ndarray:
     return x.numpy()
 
 
-def load_frames(store_path, cases=None, size: int = 224, every: int = 1) -> Frames:
-    """Every `every`-th frame of each case (all stored cases when cases is None), in time order."""
+def species_frames(frames: np.ndarray, size: int) -> np.ndarray:
+    """uint8 (n, H, W) grey frames -> float32 (n, 2, size, size): one frame per species (fine,
+    coarse; pydem.frames.species_masks), each in the grey frames' convention — 0 where the
+    species covers the pixel, 1 where it does not — area-averaged to size."""
+    from pydem.frames import species_masks
+    out = []
+    for i in range(0, len(frames), 256):
+        m = torch.from_numpy(species_masks(frames[i:i + 256]).astype(np.float32))
+        if size != m.shape[-1]:
+            m = torch.nn.functional.adaptive_avg_pool2d(m, size)
+        out.append(1.0 - m.numpy())
+    return np.concatenate(out) if out else np.zeros((0, 2, size, size), np.float32)
+
+
+INPUTS = {"grey": shrink, "species": species_frames}  # what a network sees of a stored frame
+
+
+def load_frames(store_path, cases=None, size: int = 224, every: int = 1, inputs: str = "grey") -> Frames:
+    """Every `every`-th frame of each case (all stored cases when cases is None), in time order,
+    as `inputs` gives it: the grey frame (1 channel) or its two species (INPUTS)."""
     from pydem.frames import FrameStore
+    if inputs not in INPUTS:
+        raise ValueError(f"inputs: one of {sorted(INPUTS)}, got {inputs!r}")
     store = FrameStore(store_path)
     names = cases or store.cases()
     xs, cs, ts, rs, ns, dis, attrs = [], [], [], [], [], {}, {}
     for c in names:
         d = store.read_case(c)
         sl = slice(None, None, every)
-        xs.append(shrink(d["frames"][sl], size))
+        xs.append(INPUTS[inputs](d["frames"][sl], size))
         cs += [c] * len(xs[-1])
         ts.append(d["time"][sl]), rs.append(d["remaining_time"][sl]), ns.append(d["nrrp"][sl])
         dis[c] = float(d["discharge_time"])
@@ -273,6 +293,39 @@ def fill_level_nrrp(fill_train: np.ndarray, nrrp_train: np.ndarray, fill: np.nda
     alone carries about the count that remains, once calibrated on other hoppers."""
     coeffs = np.polyfit(np.asarray(fill_train, float), np.asarray(nrrp_train, float), degree)
     return np.clip(np.polyval(coeffs, np.asarray(fill, float)), 0.0, 1.0)
+
+
+def fines_count_share(case: str) -> float:
+    """The fine spheres' share of a Table 1 case's count (its fine volume fraction and two sizes)."""
+    from pydem.rigs.table1 import TABLE1, species_counts
+    n, _nu, _e, phi, *_, dd, _rho = TABLE1[case]
+    nf, nc = species_counts(n, dd[0], dd[1], phi)
+    return nf / (nf + nc)
+
+
+def species_fill(frames: np.ndarray) -> np.ndarray:
+    """(n, H, W) uint8 grey frames of one case -> (n, 2): the pixels only fine spheres, and only
+    coarse ones, can show (pydem.frames.species_masks), each over its case's first frame's —
+    how much of each species the front view still shows."""
+    from pydem.frames import species_masks
+    counts = np.concatenate([species_masks(frames[i:i + 256]).sum(axis=(-2, -1)) for i in range(0, len(frames), 256)])
+    return counts / np.maximum(counts[:1], 1.0)
+
+
+def species_design(fill: np.ndarray, fines_share: float, degree: int = 3) -> np.ndarray:
+    """The species gauge's regressors: w F^i and (1 - w) K^i for i = 1..degree, F and K the
+    species' fill (species_fill), w the fines' share of the count: the count that remains is the
+    fines' share times the share of fines left plus the coarse's, each read from its own fill."""
+    f, k = np.asarray(fill, float).T
+    return np.column_stack([fines_share * f ** i for i in range(1, degree + 1)]
+                           + [(1.0 - fines_share) * k ** i for i in range(1, degree + 1)])
+
+
+def species_gauge_nrrp(design_train: np.ndarray, nrrp_train: np.ndarray, design: np.ndarray) -> np.ndarray:
+    """The NRRP a species gauge reads: least squares of the count on species_design's regressors
+    over training cases' whole discharges, clipped to [0, 1]."""
+    beta = np.linalg.lstsq(np.asarray(design_train, float), np.asarray(nrrp_train, float), rcond=None)[0]
+    return np.clip(np.asarray(design, float) @ beta, 0.0, 1.0)
 
 
 def constant_rate_nrrp(t: np.ndarray, nrrp: np.ndarray, fraction: float = 0.2) -> np.ndarray:

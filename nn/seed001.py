@@ -129,6 +129,10 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
             e.add_argument("--protocol", choices=("pretrained", "per-case"), default="pretrained",
                            help="pretrained: on other cases' whole discharges, fine-tuned on the case's first 20 %% "
                                 "(default); per-case: seed 001's, the first 20 %% only")
+            e.add_argument("--inputs", choices=("grey", "species"), default="grey",
+                           help="what the network sees of a frame: grey (seed 001's) or species (fine and coarse "
+                                "spheres as two channels, read from the grey levels)")
+            e.add_argument("--stride", type=int, default=4, help="pretraining windows every N frames (default 4)")
     rp = sub.add_parser("report", help="HTML + Markdown report of the GRA and the experiments' results")
     rp.add_argument("--store", required=True)
     rp.add_argument("--results", required=True, help="the experiments' --out directory")
@@ -158,7 +162,7 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
             kw |= {k: v for k, v in (("models", args.models), ("time_budget", args.time_budget)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
-            kw["protocol"] = args.protocol
+            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride}
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
         run(args.store, args.out, size=args.size, seed=args.seed, **kw)
         return 0

@@ -169,7 +169,7 @@ def _window_mse(model, xw, yw, scaling: dict) -> float:
 
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
-            device: str = "auto", say=print) -> dict:
+            device: str = "auto", inputs: str = "grey", say=print) -> dict:
     """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
 
     protocol "per-case" (seed 001's): the CNN-LSTM trained on windows of the case's first
@@ -180,7 +180,9 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     each of the fold's cases, fine-tuned on windows of that case's first `fraction` (lr / 10,
     `finetune_epochs`), the fine-tuned weights kept only where they lower the error on the
     case's own held-back early windows. The zero-shot prediction (no frame of the case seen) is
-    reported beside it. In both, each later frame's NRRP is read from the window ending at it."""
+    reported beside it. In both, each later frame's NRRP is read from the window ending at it.
+    `inputs`: what the network sees of a frame (images.INPUTS): the grey frame, seed 001's, or
+    its two species (fine, coarse) as separate channels."""
     from pydem.frames import FrameStore
     if protocol not in ("pretrained", "per-case"):
         raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
@@ -188,18 +190,18 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     out = Path(out)
     dev = images.pick_device(device)
     res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
-                        "protocol": protocol, "gradient_clip": LSTM_CLIP, "device": str(dev)} | ({"stride": stride, "finetune_epochs": finetune_epochs,
+                        "protocol": protocol, "inputs": inputs, "gradient_clip": LSTM_CLIP, "device": str(dev)} | ({"stride": stride, "finetune_epochs": finetune_epochs,
                                                   "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
            "machine": _machine(dev), "cases": {}}
     cases = FrameStore(store).cases()
-    data = {c: images.load_frames(store, cases=[c], size=size) for c in cases}
+    data = {c: images.load_frames(store, cases=[c], size=size, inputs=inputs) for c in cases}
     folds = sorted({_fold(c) for c in cases})
-    pretrained, fills = {}, {}
+    pretrained, gauges = {}, {}
     if protocol == "pretrained":
         if len(folds) < 3:
             raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
         whole = {c: _nrrp_windows(data[c], window, stride) for c in cases if len(data[c].x) >= window}
-        fills = {c: images.fill_fraction(data[c].x, data[c].x[0]) for c in cases}  # the fill-level gauge's input
+        gauges = gauge_inputs(store, cases, size)
         for fold in folds:
             val_fold = validation_fold(fold, folds)
             tr = [w for c, w in whole.items() if _fold(c) in pretraining_folds(fold, folds)]
@@ -209,7 +211,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
                 f"(validation: fold {val_fold}, {len(xv)} windows)")
             torch.manual_seed(seed)
-            model = cnn.CNNLSTM().to(dev)
+            model = cnn.CNNLSTM(in_channels=xt.shape[2]).to(dev)
             t0 = time.perf_counter()
             scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
                                  checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=images.Progress(say))
@@ -226,7 +228,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         t0 = time.perf_counter()
         if protocol == "per-case":
             torch.manual_seed(seed)
-            model = cnn.CNNLSTM().to(dev)
+            model = cnn.CNNLSTM(in_channels=f.x.shape[1]).to(dev)
             scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
                                  lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
         else:
@@ -248,15 +250,13 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         row |= {"net": images.scores(truth, pred), "baseline": images.scores(truth, base), "time": f.time[k:].tolist(),
                 "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": base.tolist()}
         if protocol == "pretrained":
-            gauge = fill_level_baseline(case, fills, data, folds, k)
-            if gauge is not None:
-                row |= {"fill_level": images.scores(truth, gauge), "fill_level_nrrp": gauge.tolist()}
+            row |= gauge_rows(case, gauges, data, folds, k)
         res["cases"][case] = row
         say(f"  {case}: relative error {row['net']['relative_error']:.3f} "
             + (f"(zero-shot {row['zero_shot']['relative_error']:.3f}) " if "zero_shot" in row else "")
             + f"(constant rate {row['baseline']['relative_error']:.3f}"
-            + (f", fill-level gauge {row['fill_level']['relative_error']:.3f}" if "fill_level" in row else "") + ")")
-    keys = ("net", "baseline") + (("zero_shot", "fill_level") if protocol == "pretrained" else ())
+            + "".join(f", {g.replace('_', ' ')} gauge {row[g]['relative_error']:.3f}" for g in GAUGES if g in row) + ")")
+    keys = ("net", "baseline") + (("zero_shot",) + GAUGES if protocol == "pretrained" else ())
     res["per_packing"] = {pk: {key: float(np.mean(errs)) for key in keys
                                if (errs := [r[key]["relative_error"] for c, r in res["cases"].items()
                                             if _packing(c) == pk and key in r])}
@@ -281,15 +281,41 @@ def pretraining_folds(fold: str, folds: list[str]) -> list[str]:
     return [f for f in folds if f not in (fold, validation_fold(fold, folds))]
 
 
-def fill_level_baseline(case: str, fills: dict, data: dict, folds: list[str], k: int) -> np.ndarray | None:
-    """The case's NRRP from frame k on as a fill-level gauge reads it, calibrated on the whole
-    discharges of the cases of its packing that its network pretrains on (images.fill_level_nrrp):
-    the same cases, the same frames, no learning beyond a cubic. None without such cases."""
-    train = [c for c in fills if _packing(c) == _packing(case) and _fold(c) in pretraining_folds(_fold(case), folds)]
-    if not train:
-        return None
-    return images.fill_level_nrrp(np.concatenate([fills[c] for c in train]),
-                                  np.concatenate([data[c].nrrp for c in train]), fills[case][k:])
+GAUGES = ("fill_level", "species")  # the image gauges beside the pretrained network (gauge_rows)
+SPECIES_DEGREE = 2
+
+
+def gauge_inputs(store, cases, size: int) -> dict:
+    """What the image gauges read of each case's frames: its grey fill fraction at the network's
+    frame size (images.fill_fraction) and the fill of each species (images.species_fill, from
+    the stored 224 x 224 frames), with the fines' share of its count."""
+    from pydem.frames import FrameStore
+    st, out = FrameStore(store), {}
+    for c in cases:
+        raw = st.read_case(c)["frames"]
+        grey = images.shrink(raw, size)
+        out[c] = {"fill": images.fill_fraction(grey, grey[0]), "species": images.species_fill(raw),
+                  "fines_share": images.fines_count_share(c)}
+    return out
+
+
+def gauge_rows(case: str, gauges: dict, data: dict, folds: list[str], k: int) -> dict:
+    """The case's NRRP from frame k on as two image gauges read it, each calibrated on the whole
+    discharges of cases its network pretrains on — the same cases, the same frames, no learning
+    beyond least squares, per packing: `fill_level`, a cubic of the grey fill fraction
+    (images.fill_level_nrrp); `species`, the count from each species' fill, quadratic in each
+    (images.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
+    per packing erred least on the 1 ms frame set, 2026-11-28). Their scores and readings."""
+    same = [c for c in gauges if _packing(c) == _packing(case) and _fold(c) in pretraining_folds(_fold(case), folds)]
+    g, row = gauges[case], {}
+    if same:
+        design = lambda c: images.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
+        row["fill_level"] = images.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in same]),
+                                                   np.concatenate([data[c].nrrp for c in same]), g["fill"][k:])
+        row["species"] = images.species_gauge_nrrp(np.concatenate([design(c) for c in same]),
+                                                   np.concatenate([data[c].nrrp for c in same]), design(case)[k:])
+    truth = data[case].nrrp[k:]
+    return {name: images.scores(truth, v) for name, v in row.items()} | {f"{name}_nrrp": v.tolist() for name, v in row.items()}
 
 
 def _save(path: Path, res: dict):

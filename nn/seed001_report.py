@@ -109,11 +109,12 @@ def process_section(res: dict, plots: dict):
     from pydem.calibration.report import _png, _table
     import matplotlib.pyplot as plt
     zero = any("zero_shot" in v for v in res["per_packing"].values())
-    gauge = all("fill_level" in v for v in res["per_packing"].values())  # runs before 2026-11-28 lack it
+    # the gauges each run has (older runs lack one or both)
+    gauges = [g for g in ("fill_level", "species") if all(g in v for v in res["per_packing"].values())]
     rows = [[pk, _f(v["net"])] + ([_f(v["zero_shot"])] if zero else []) + [_f(v["baseline"])]
-            + ([_f(v["fill_level"])] if gauge else []) for pk, v in res["per_packing"].items()]
+            + [_f(v[g]) for g in gauges] for pk, v in res["per_packing"].items()]
     md, h = _table(rows, ["packing", "CNN-LSTM relative error"] + (["zero-shot (no frame of the case)"] if zero else [])
-                   + ["constant-rate relative error"] + (["fill-level gauge relative error"] if gauge else []))
+                   + ["constant-rate relative error"] + [f"{g.replace('_', '-')} gauge relative error" for g in gauges])
     fig, axes = plt.subplots(1, 5, figsize=(13, 2.8), sharey=True)
     for ax, pk in zip(axes, ("A", "B1", "B2", "B3", "B4")):
         cases = [c for c in res["cases"] if c.split("-")[0] == pk]
@@ -123,8 +124,9 @@ def process_section(res: dict, plots: dict):
         ax.plot(r["time"], r["nrrp"], "k-", label="DEM")
         ax.plot(r["time"], r["predicted"], "C0--", label="CNN-LSTM")
         ax.plot(r["time"], r["baseline_nrrp"], "C1:", label="constant rate")
-        if "fill_level_nrrp" in r:
-            ax.plot(r["time"], r["fill_level_nrrp"], "C2-.", label="fill-level gauge")
+        for g, style in (("fill_level", "C2-."), ("species", "C3-.")):
+            if f"{g}_nrrp" in r:
+                ax.plot(r["time"], r[f"{g}_nrrp"], style, label=f"{g.replace('_', '-')} gauge")
         ax.set_title(cases[0], fontsize=9)
         ax.set_xlabel("t (s)")
     axes[0].set_ylabel("NRRP")
@@ -136,7 +138,8 @@ def process_section(res: dict, plots: dict):
                f"each case's first {st['fraction']:.0%} ({st['finetune_epochs']} epochs)")
     else:
         how = f"Per case: trained on the first {st['fraction']:.0%} of its frames, {st['epochs']} epochs"
-    line = f"{how}; windows of {st['window']}, frames {st['size']} x {st['size']}. Seed 001: {SEED_LSTM}."
+    seen = " (two channels: fine and coarse spheres)" if st.get("inputs") == "species" else ""
+    line = f"{how}; windows of {st['window']}, frames {st['size']} x {st['size']}{seen}. Seed 001: {SEED_LSTM}."
     return "CNN-LSTM process prediction (NRRP)", line + "\n\n" + md, f"<p>{line}</p>" + h
 
 

@@ -15,6 +15,15 @@ import numpy as np
 
 CROP = 224
 
+# What a grey frame's levels mean (libdem's DEM_COLOR_GREY, as the hopper rig draws its frames):
+# coarse spheres (material 0) at 70 and fine ones (material 2) at 110, each shaded by 0.45-1
+# across its disk; walls drawn at 40, background 255. A pixel brighter than 70 can only be a
+# fine sphere, one darker than 0.45 x 110 only a coarse one (or a wall): each band covers a
+# fixed share of its species' disks, so its pixel count follows that species' visible area.
+FINE_GREYS = (71, 110)
+COARSE_GREYS = (32, 49)
+WALL_GREY = 40
+
 
 def crop_grey(rgb: np.ndarray, size: int = CROP) -> np.ndarray:
     """(H, W, 3) uint8 -> (size, size) uint8: the centre crop (the extra row/column of an odd
@@ -25,6 +34,18 @@ def crop_grey(rgb: np.ndarray, size: int = CROP) -> np.ndarray:
     top, left = (h - size) // 2, (w - size) // 2
     c = rgb[top:top + size, left:left + size].astype(np.float64)
     return np.rint(c @ np.array([0.299, 0.587, 0.114])).clip(0, 255).astype(np.uint8)
+
+
+def species_masks(frames: np.ndarray) -> np.ndarray:
+    """(n, H, W) uint8 grey frames of the hopper rig -> bool (n, 2, H, W): [fine, coarse] — the
+    pixels only a fine sphere's disk, and only a coarse one's, can have (FINE_GREYS,
+    COARSE_GREYS; the wall grey left out). What the front view shows of each species."""
+    f = np.asarray(frames)
+    if f.dtype != np.uint8 or f.ndim != 3:
+        raise ValueError(f"species_masks: (n, H, W) uint8 grey frames are needed, got {f.dtype} {f.shape}")
+    fine = (f >= FINE_GREYS[0]) & (f <= FINE_GREYS[1])
+    coarse = (f >= COARSE_GREYS[0]) & (f <= COARSE_GREYS[1]) & (f != WALL_GREY)
+    return np.stack([fine, coarse], axis=1)
 
 
 class FrameStore:

@@ -96,6 +96,41 @@ def test_fill_level_gauge_recovers_a_cubic_reading_and_stays_in_0_1():
     assert images.fill_level_nrrp(fill, law(fill), np.array([3.0, 5.0])).tolist() == [1.0, 0.0]  # 2.8, -3.4
 
 
+def test_species_gauge_recovers_a_two_species_count_and_stays_in_0_1():
+    # cases whose remaining count is w f(F) + (1 - w) g(K), each species' count a known cubic
+    # of its visible fill: fitted on three cases (w 0.3, 0.6, 0.9), read exactly on a fourth
+    rng = np.random.default_rng(3)
+    f = lambda v: 0.2 * v + 0.5 * v ** 2 + 0.3 * v ** 3  # noqa: E731
+    g = lambda v: 0.9 * v + 0.1 * v ** 3  # noqa: E731
+    case = lambda w, n=40: (rng.uniform(0, 1, (n, 2)), w)  # noqa: E731
+    law = lambda fill, w: w * f(fill[:, 0]) + (1 - w) * g(fill[:, 1])  # noqa: E731
+    train = [case(w) for w in (0.3, 0.6, 0.9)]
+    design = np.concatenate([images.species_design(fill, w) for fill, w in train])
+    counts = np.concatenate([law(fill, w) for fill, w in train])
+    new, w = case(0.75)
+    assert np.allclose(images.species_gauge_nrrp(design, counts, images.species_design(new, w)), law(new, w), atol=1e-12)
+    assert images.species_gauge_nrrp(design, counts, images.species_design(np.array([[3.0, 3.0]]), w)).tolist() == [1.0]
+
+
+def test_fines_count_share_of_a_table1_case():
+    # B1-2: 7,596 spheres of 3 and 9 mm, fine volume fraction 0.4 -> a coarse sphere holds 27 fine
+    # volumes, so fines are 0.4 x 27 / (0.4 x 27 + 0.6) = 0.947 of the count
+    assert images.fines_count_share("B1-2") == pytest.approx(0.4 * 27 / (0.4 * 27 + 0.6), abs=1 / 7596)
+
+
+def test_species_frames_are_one_grey_frame_per_species():
+    # a frame half fine-grey (100), a quarter coarse-grey (45), a quarter wall (40) and background
+    frame = np.full((1, 8, 8), 255, np.uint8)
+    frame[0, :4] = 100
+    frame[0, 4:6] = 45
+    frame[0, 6:, :4] = 40
+    x = images.species_frames(frame, 8)
+    assert x.shape == (1, 2, 8, 8) and x.dtype == np.float32
+    assert x[0, 0, :4].max() == 0.0 and x[0, 0, 4:].min() == 1.0   # fine channel: dark where fines are
+    assert x[0, 1, 4:6].max() == 0.0 and x[0, 1, 6:].min() == 1.0 and x[0, 1, :4].min() == 1.0
+    assert images.species_frames(frame, 2)[0, 0].tolist() == [[0.0, 0.0], [1.0, 1.0]]  # area-averaged
+
+
 def test_beverloo_baseline_recovers_its_law():
     from pydem.rigs.hopper import TABLE1
     c_true, k_true = 0.58, 1.4

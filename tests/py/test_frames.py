@@ -4,7 +4,7 @@ keeps labels with frames and writes a case whole (a half-written case is not lis
 import numpy as np
 import pytest
 
-from pydem.frames import FrameStore, crop_grey
+from pydem.frames import FrameStore, crop_grey, species_masks
 
 
 def test_crop_is_centred_and_grey_is_bt601():
@@ -18,6 +18,41 @@ def test_crop_is_centred_and_grey_is_bt601():
     assert crop_grey(np.full((230, 420, 3), 255, np.uint8))[0, 0] == 255
     with pytest.raises(ValueError, match="224"):
         crop_grey(np.zeros((100, 420, 3), np.uint8))
+
+
+def test_species_masks_follow_the_renderer_grey_levels():
+    """libdem's grey frames as the hopper rig draws them (coarse = material 0, fine = material 2,
+    a wall): every fine-band pixel lies on the fine sphere's disk, every coarse-band pixel on the
+    coarse one's, none on the wall, and each band covers a steady share of its disk (the shading
+    is the same on every sphere, so the share is what ties a pixel count to an area)."""
+    import pydem
+    d = pydem.Domain(lo=(0, 0, 0), hi=(0.1, 0.02, 0.05), gravity=(0, 0, 0))
+    for _ in range(3):
+        d.set_pair(m := d.add_material(), m)
+    d.add_particles([[0.03, 0.01, 0.025], [0.07, 0.01, 0.025]], [0.012, 0.006], [0, 2])
+    d.add_plane_wall(axis=0, side=1, position=0.001, material=0)
+    img = crop_grey(d.render(width=420, height=230, view_axis=1, window=((0.0, 0.1), (0.0, 0.05)), color="grey"))
+    fine, coarse = species_masks(img[None])[0]
+    # the centre crop keeps columns 98..321 of 420: x = 0.0233 .. 0.0767 m; rows 3..226 of 230
+    x = 0.0233 + (np.arange(224) + 0.5) / 4200.0
+    z = 0.05 - (np.arange(224)[:, None] + 3.5) / 4600.0
+    on = lambda cx, r: (x - cx) ** 2 + (z - 0.025) ** 2 <= (r * 1.05) ** 2  # noqa: E731  (a pixel of margin)
+    assert fine.any() and coarse.any()
+    assert not (fine & ~on(0.07, 0.006)).any() and not (coarse & ~on(0.03, 0.012)).any()
+    share = lambda mask, cx, r: mask.sum() / on(cx, r / 1.05).sum()  # noqa: E731
+    # closed form: the renderer's shading law over a unit disk gives the bands 0.862 and 0.197 of
+    # it; the pixel grid shifts them by about a rim pixel (coarse: a ring of 1 px at r = 50 px is
+    # 4 % of the disk, and the coarse band is the rim)
+    u = np.linspace(-1, 1, 1001)
+    du, dv = np.meshgrid(u, u)
+    inside = du ** 2 + dv ** 2 <= 1
+    shade = np.minimum(1, 0.45 + 0.55 * np.maximum(0, 0.8 * np.sqrt(np.clip(1 - du ** 2 - dv ** 2, 0, 1))
+                                                       - 0.35 * du - 0.35 * dv + 0.2))
+    law = lambda grey, band: species_masks(np.rint(grey * shade).astype(np.uint8)[None])[0, band][inside].mean()  # noqa: E731
+    assert share(fine, 0.07, 0.006) == pytest.approx(law(110, 0), abs=0.02)
+    assert share(coarse, 0.03, 0.012) == pytest.approx(law(70, 1), abs=0.04)
+    with pytest.raises(ValueError, match="uint8"):
+        species_masks(img.astype(float)[None])
 
 
 def test_store_round_trip_and_whole_cases(tmp_path):

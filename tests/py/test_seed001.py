@@ -61,7 +61,7 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, say=lambda *a: None)
     assert set(proc["per_packing"]) == {"A", "B1", "B2", "B3", "B4"}
     assert proc["settings"]["protocol"] == "pretrained"
-    assert all(set(v) == {"net", "baseline", "zero_shot", "fill_level"} for v in proc["per_packing"].values())
+    assert all(set(v) == {"net", "baseline", "zero_shot", "fill_level", "species"} for v in proc["per_packing"].values())
     # the gauge is calibrated on the cases the network pretrains on: for fold 1, folds 3, 4, 5
     assert ex.pretraining_folds("1", ["1", "2", "3", "4", "5"]) == ["3", "4", "5"]
     assert all(isinstance(r["finetune_kept"], bool) for r in proc["cases"].values())
@@ -69,6 +69,11 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     text = page.read_text()
     assert "Grey relational analysis" in text and "AlexNet-FC point to point" in text and "data:image/png;base64," in text
     assert json.loads((tmp_path / "process.json").read_text())["settings"]["window"] == 2
+    # the network on the two species' channels: same protocol, same gauges
+    sp = ex.process(SUBSET, tmp_path / "species", size=32, window=2, epochs=1, fraction=0.4, inputs="species",
+                    say=lambda *a: None)
+    assert sp["settings"]["inputs"] == "species" and set(sp["per_packing"]) == set(proc["per_packing"])
+    assert sp["cases"]["B1-1"]["species"] == proc["cases"]["B1-1"]["species"]  # the gauges do not depend on it
 
 
 def test_windows_with_a_stride_start_every_stride_frames():
