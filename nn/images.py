@@ -295,10 +295,11 @@ def fill_level_nrrp(fill_train: np.ndarray, nrrp_train: np.ndarray, fill: np.nda
     return np.clip(np.polyval(coeffs, np.asarray(fill, float)), 0.0, 1.0)
 
 
-def fines_count_share(case: str) -> float:
-    """The fine spheres' share of a Table 1 case's count (its fine volume fraction and two sizes)."""
+def fines_count_share(case: str, row: tuple | None = None) -> float:
+    """The fine spheres' share of a Table 1 case's count (its fine volume fraction and two sizes),
+    or of a hopper given by its Table 1-style row."""
     from pydem.rigs.table1 import TABLE1, species_counts
-    n, _nu, _e, phi, *_, dd, _rho = TABLE1[case]
+    n, _nu, _e, phi, *_, dd, _rho = row if row is not None else TABLE1[case]
     nf, nc = species_counts(n, dd[0], dd[1], phi)
     return nf / (nf + nc)
 

@@ -98,8 +98,16 @@ class HopperConfig:
 
 def apply_case(cfg: HopperConfig, name: str):
     """Sets the 11 Table 1 parameters of case `name` (and its packing) on cfg."""
-    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[name]
-    cfg.case, cfg.packing = name, name.split("-")[0]
+    cfg.case = name
+    apply_row(cfg, TABLE1[name], name.split("-")[0])
+
+
+def apply_row(cfg: HopperConfig, row: tuple, packing: str):
+    """Sets 11 parameters given as a Table 1 row (N, nu, E GPa, fine volume fraction, e_pp, e_wp,
+    mu_pp, mu_wp, mu_r, (d_fine, d_coarse) mm, rho) and the packing on cfg: a Table 1 case, or a
+    hopper drawn like them."""
+    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = row
+    cfg.packing = packing
     cfg.particles, cfg.fine_fraction = n, phi
     cfg.d_small, cfg.d_large = dd[0] / 1000.0, dd[1] / 1000.0  # mm -> m (9 / 1000 is exactly 0.009)
     p = cfg.params

@@ -4,6 +4,8 @@ without pydem's compiled binding (the image networks read it on machines where l
 built)."""
 from __future__ import annotations
 
+import math
+
 # seed 001, Table 1: N, nu, E (GPa), fine volume fraction, e_pp, e_wp, mu_pp, mu_wp, mu_r, d (mm), rho
 TABLE1 = {
     "A-1": (620, 0.35, 0.01, 0.2, 0.3, 0.1, 0.5, 0.2, 0.08, (6, 9), 2800),
@@ -39,3 +41,30 @@ def species_counts(n: int, d_small: float, d_large: float, fine_fraction: float)
     ratio = (d_large / d_small) ** 3  # a coarse sphere holds `ratio` fine volumes
     n_fine = round(n * fine_fraction * ratio / (fine_fraction * ratio + (1.0 - fine_fraction)))
     return int(n_fine), int(n - n_fine)
+
+
+def draw_like_table1(packing: str, hoppers: int, seed: int) -> dict[str, tuple]:
+    """{name: row} of `hoppers` hoppers drawn like Table 1's (named <packing>-x01 ...): each
+    parameter from the values its column holds over the 25 cases, independently, and the sphere
+    count from the drawn sizes and fine fraction and the solid volume of a Table 1 case drawn at
+    random (the seed keeps the bed's volume roughly fixed)."""
+    import numpy as np
+    rows = list(TABLE1.values())
+    rng = np.random.default_rng(seed)
+    pick = lambda col: rows[rng.integers(len(rows))][col]  # noqa: E731
+    out = {}
+    for i in range(hoppers):
+        nu, e, phi, epp, ewp, mupp, muwp, mur, dd, rho = (pick(c) for c in range(1, 11))
+        like = rows[rng.integers(len(rows))]  # the bed's solid volume of a Table 1 case
+        volume = solid_volume(like)
+        vs, vl = (math.pi / 6 * (d / 1000.0) ** 3 for d in dd)
+        n = int(round(volume * phi / vs + volume * (1 - phi) / vl))
+        out[f"{packing}-x{i + 1:02d}"] = (n, nu, e, phi, epp, ewp, mupp, muwp, mur, dd, rho)
+    return out
+
+
+def solid_volume(row: tuple) -> float:
+    """m^3 of spheres in a Table 1-style row."""
+    n, phi, dd = row[0], row[3], row[9]
+    nf, nc = species_counts(n, dd[0], dd[1], phi)
+    return math.pi / 6 * (nf * (dd[0] / 1000.0) ** 3 + nc * (dd[1] / 1000.0) ** 3)

@@ -58,6 +58,24 @@ def test_table1_cases_by_name():
     assert phi == pytest.approx(0.8, abs=1e-3)
 
 
+def test_hoppers_drawn_like_table1():
+    """Seeded draws; each parameter one its Table 1 column holds; the bed's solid volume one of
+    Table 1's to within a sphere; a row applied as a case is applied (apply_row = apply_case)."""
+    from pydem.rigs.hopper import apply_row
+    from pydem.rigs.table1 import draw_like_table1, solid_volume
+    rows = draw_like_table1("B4", 6, seed=3)
+    assert rows == draw_like_table1("B4", 6, seed=3) and list(rows)[0] == "B4-x01"
+    volumes = sorted(solid_volume(r) for r in TABLE1.values())
+    for row in rows.values():
+        assert all(row[c] in {r[c] for r in TABLE1.values()} for c in range(1, 11))
+        v, sphere = solid_volume(row), math.pi / 6 * (row[9][1] / 1000.0) ** 3
+        assert min(abs(v - u) for u in volumes) <= sphere
+    a, b = load(HopperConfig, "default", overrides=["case=B3-2"]), HopperConfig.preset("default")
+    apply_row(b, TABLE1["B3-2"], "B3")
+    b.case = "B3-2"
+    assert a == b
+
+
 def test_layered_packings_order():
     h = Hopper(load(HopperConfig, "tiny", overrides=["packing=B3"]))
     order = h._filling_order(np.random.default_rng(0), 10, 4)

@@ -1,0 +1,137 @@
+"""Would more hoppers carry the image-to-count law? The image gauges of `process`
+(nn.seed001_experiments.gauge_rows) read the five Table 1 cases of a packing after calibrating on
+its three pretraining-fold cases; here they are calibrated again with M more hoppers of the same
+packing added, drawn like Table 1's, and the errors compared.
+
+The hoppers are drawn by pydem.rigs.table1.draw_like_table1. Each runs
+at full size with a frame every `--frame-interval` into its own store (resumable: hoppers
+already stored are skipped), two at a time.
+
+    .venv/bin/python bench/nrrp_more_hoppers.py run --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
+    .venv/bin/python bench/nrrp_more_hoppers.py evaluate --packing B1 --store data/seed001/extra_B1.h5 \\
+        --table1 data/seed001/frames_full.h5 --out bench/results/seed001/nrrp_more_hoppers_B1.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def run_one(name: str, row: tuple, packing: str, frame_interval: float):
+    from pydem.rigs import RIGS, load
+    from pydem.rigs.hopper import apply_row
+    cls, cfg_cls = RIGS["hopper"]
+    cfg = load(cfg_cls, "default", None, [f"frame_interval={frame_interval}", "num_threads=1"])
+    apply_row(cfg, row, packing)
+    t0 = time.perf_counter()
+    try:
+        res = cls(cfg).run(seed=0, images=True)
+    except Exception as exc:  # one hopper that fails does not stop the others
+        return name, None, f"failed ({exc})"
+    t_dis = res.metrics["discharge_time"].value
+    if not np.isfinite(t_dis):
+        return name, None, f"did not empty ({res.metrics['discharge_time'].note})"
+    return name, (res.images, res.series["frame_time"], t_dis, res.series["frame_nrrp"]), time.perf_counter() - t0
+
+
+def run(args) -> int:
+    from pydem.frames import FrameStore
+    from pydem.rigs.table1 import draw_like_table1
+    store = FrameStore(args.store)
+    rows = draw_like_table1(args.packing, args.hoppers, args.seed)
+    todo = {k: v for k, v in rows.items() if k not in set(store.cases())}
+    print(f"{len(rows) - len(todo)} of {len(rows)} hoppers stored; running {len(todo)}, {args.workers} at a time")
+    with ProcessPoolExecutor(args.workers) as pool:
+        jobs = [pool.submit(run_one, k, v, args.packing, args.frame_interval) for k, v in todo.items()]
+        for job in as_completed(jobs):  # stored as each finishes: a killed run keeps what it made
+            name, got, info = job.result()
+            if got is None:
+                print(f"  {name}: {info}; not stored")
+                continue
+            frames, t, t_dis, nrrp = got
+            store.write_case(name, frames, t, t_dis, nrrp, {"packing": args.packing, "row": json.dumps(rows[name]),
+                                                             "frame_interval": args.frame_interval, "dem_seconds": info})
+            print(f"  {name}: N {rows[name][0]}, {len(frames)} frames, discharge {t_dis:.3f} s, {info:.0f} s", flush=True)
+    return 0
+
+
+def evaluate(args) -> int:
+    from nn import images
+    from nn import seed001_experiments as ex
+    from pydem.frames import FrameStore
+    table1 = [c for c in FrameStore(args.table1).cases() if ex._packing(c) == args.packing]
+    extra_store = FrameStore(args.store)
+    extra = extra_store.cases()
+    inputs = ex.gauge_inputs(args.table1, table1, args.size)
+    nrrp = {c: FrameStore(args.table1).read_case(c)["nrrp"] for c in table1}
+    for c in extra:
+        d = extra_store.read_case(c)
+        raw, row = d["frames"], tuple(json.loads(d["row"]))
+        row = row[:9] + (tuple(row[9]),) + row[10:]
+        grey = images.shrink(raw, args.size)
+        inputs[c] = {"fill": images.fill_fraction(grey, grey[0]), "species": images.species_fill(raw),
+                     "fines_share": images.fines_count_share(c, row)}
+        nrrp[c] = d["nrrp"]
+    folds = sorted({ex._fold(c) for c in table1})
+    data = {c: type("F", (), {"nrrp": v})() for c, v in nrrp.items()}
+    out = {"packing": args.packing, "size": args.size, "extra": extra, "cases": {}}
+    for case in table1:
+        k = ex.first_part(len(nrrp[case]), 0.2, 8)
+        base = [c for c in table1 if ex._fold(c) in ex.pretraining_folds(ex._fold(case), folds)]
+        row = {}
+        for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra)):
+            row[label] = calibrated(case, inputs, data, train, k)
+        out["cases"][case] = row
+        print(f"{case}: " + "  ".join(f"{lab}: fill {r['fill_level']:.3f} species {r['species']:.3f}" for lab, r in row.items()))
+    out["mean"] = {lab: {g: float(np.mean([out["cases"][c][lab][g] for c in table1])) for g in ex.GAUGES}
+                   for lab in ("table1", "table1+extra", "extra")}
+    for lab, v in out["mean"].items():
+        print(f"mean over {args.packing}, calibrated on {lab}: " + ", ".join(f"{g} {e:.3f}" for g, e in v.items()))
+    Path(args.out).write_text(json.dumps(out, indent=1))
+    return 0
+
+
+def calibrated(case: str, inputs: dict, data: dict, train: list[str], k: int) -> dict:
+    """Relative errors of both gauges on the case from frame k, calibrated on `train` as
+    nn.seed001_experiments.gauge_rows calibrates them."""
+    from nn import images
+    from nn import seed001_experiments as ex
+    design = lambda c: images.species_design(inputs[c]["species"], inputs[c]["fines_share"], ex.SPECIES_DEGREE)  # noqa: E731
+    y = np.concatenate([data[c].nrrp for c in train])
+    truth = data[case].nrrp[k:]
+    fill = images.fill_level_nrrp(np.concatenate([inputs[c]["fill"] for c in train]), y, inputs[case]["fill"][k:])
+    species = images.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])
+    return {"fill_level": images.scores(truth, fill)["relative_error"], "species": images.scores(truth, species)["relative_error"]}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
+    r.add_argument("--hoppers", type=int, default=12)
+    r.add_argument("--seed", type=int, default=1)
+    r.add_argument("--store", required=True)
+    r.add_argument("--frame-interval", type=float, default=0.001)
+    r.add_argument("--workers", type=int, default=2)
+    e = sub.add_parser("evaluate")
+    e.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
+    e.add_argument("--store", required=True)
+    e.add_argument("--table1", required=True, help="the frame store of the 25 Table 1 cases")
+    e.add_argument("--size", type=int, default=224, help="frame side of the fill-level gauge")
+    e.add_argument("--out", required=True)
+    args = ap.parse_args()
+    return run(args) if args.cmd == "run" else evaluate(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
