@@ -66,7 +66,6 @@ def run(args) -> int:
 
 
 def evaluate(args) -> int:
-    from nn import images
     from nn import seed001_experiments as ex
     from pydem.frames import FrameStore
     table1 = [c for c in FrameStore(args.table1).cases() if ex._packing(c) == args.packing]
@@ -74,24 +73,21 @@ def evaluate(args) -> int:
     extra = extra_store.cases()
     inputs = ex.gauge_inputs(args.table1, table1, args.size)
     nrrp = {c: FrameStore(args.table1).read_case(c)["nrrp"] for c in table1}
+    rows = {}
     for c in extra:
         d = extra_store.read_case(c)
-        raw, row = d["frames"], tuple(json.loads(d["row"]))
-        row = row[:9] + (tuple(row[9]),) + row[10:]
-        grey = images.shrink(raw, args.size)
-        inputs[c] = {"fill": images.fill_fraction(grey, grey[0]), "species": images.species_fill(raw),
-                     "fines_share": images.fines_count_share(c, row)}
-        nrrp[c] = d["nrrp"]
+        row = json.loads(d["row"])
+        rows[c], nrrp[c] = tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]), d["nrrp"]
+    inputs |= ex.gauge_inputs(args.store, extra, args.size, rows)
     folds = sorted({ex._fold(c) for c in table1})
-    data = {c: type("F", (), {"nrrp": v})() for c, v in nrrp.items()}
     out = {"packing": args.packing, "size": args.size, "extra": extra, "cases": {}}
     for case in table1:
         k = ex.first_part(len(nrrp[case]), 0.2, 8)
         base = [c for c in table1 if ex._fold(c) in ex.pretraining_folds(ex._fold(case), folds)]
         row = {}
         for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra)):
-            row[label] = calibrated(case, inputs, data, train, k)
-            row[label]["chosen"] = row[label][chosen_gauge(inputs, data, train)]
+            row[label] = calibrated(case, inputs, nrrp, train, k)
+            row[label]["chosen"] = row[label][chosen_gauge(inputs, nrrp, train)]
         out["cases"][case] = row
         print(f"{case}: " + "  ".join(f"{lab}: fill {r['fill_level']:.3f} species {r['species']:.3f} chosen {r['chosen']:.3f}"
                                       for lab, r in row.items()))
@@ -103,23 +99,23 @@ def evaluate(args) -> int:
     return 0
 
 
-def chosen_gauge(inputs: dict, data: dict, train: list[str]) -> str:
+def chosen_gauge(inputs: dict, nrrp: dict, train: list[str]) -> str:
     """The gauge a user would pick from the training hoppers alone: the one whose error, each
     hopper read by a gauge calibrated on the others (from its first 20 % on), is smaller."""
     from nn import seed001_experiments as ex
-    errs = [calibrated(c, inputs, data, [t for t in train if t != c], ex.first_part(len(data[c].nrrp), 0.2, 8))
+    errs = [calibrated(c, inputs, nrrp, [t for t in train if t != c], ex.first_part(len(nrrp[c]), 0.2, 8))
             for c in train]
     return min(ex.GAUGES, key=lambda g: np.mean([e[g] for e in errs]))
 
 
-def calibrated(case: str, inputs: dict, data: dict, train: list[str], k: int) -> dict:
+def calibrated(case: str, inputs: dict, nrrp: dict, train: list[str], k: int) -> dict:
     """Relative errors of both gauges on the case from frame k, calibrated on `train` as
     nn.seed001_experiments.gauge_rows calibrates them."""
     from nn import images
     from nn import seed001_experiments as ex
     design = lambda c: images.species_design(inputs[c]["species"], inputs[c]["fines_share"], ex.SPECIES_DEGREE)  # noqa: E731
-    y = np.concatenate([data[c].nrrp for c in train])
-    truth = data[case].nrrp[k:]
+    y = np.concatenate([nrrp[c] for c in train])
+    truth = nrrp[case][k:]
     fill = images.fill_level_nrrp(np.concatenate([inputs[c]["fill"] for c in train]), y, inputs[case]["fill"][k:])
     species = images.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])
     return {"fill_level": images.scores(truth, fill)["relative_error"], "species": images.scores(truth, species)["relative_error"]}

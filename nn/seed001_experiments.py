@@ -285,17 +285,18 @@ GAUGES = ("fill_level", "species")  # the image gauges beside the pretrained net
 SPECIES_DEGREE = 2
 
 
-def gauge_inputs(store, cases, size: int) -> dict:
+def gauge_inputs(store, cases, size: int, rows: dict | None = None) -> dict:
     """What the image gauges read of each case's frames: its grey fill fraction at the network's
     frame size (images.fill_fraction) and the fill of each species (images.species_fill, from
-    the stored 224 x 224 frames), with the fines' share of its count."""
+    the stored 224 x 224 frames), with the fines' share of its count (from Table 1, or from
+    rows[case], a Table 1-style row, for a hopper not in it)."""
     from pydem.frames import FrameStore
     st, out = FrameStore(store), {}
     for c in cases:
         raw = st.read_case(c)["frames"]
         grey = images.shrink(raw, size)
         out[c] = {"fill": images.fill_fraction(grey, grey[0]), "species": images.species_fill(raw),
-                  "fines_share": images.fines_count_share(c)}
+                  "fines_share": images.fines_count_share(c, (rows or {}).get(c))}
     return out
 
 
