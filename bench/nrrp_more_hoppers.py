@@ -109,16 +109,12 @@ def chosen_gauge(inputs: dict, nrrp: dict, train: list[str]) -> str:
 
 
 def calibrated(case: str, inputs: dict, nrrp: dict, train: list[str], k: int) -> dict:
-    """Relative errors of both gauges on the case from frame k, calibrated on `train` as
-    nn.seed001_experiments.gauge_rows calibrates them."""
+    """Relative errors of both gauges on the case from frame k, calibrated on `train`
+    (nn.seed001_experiments.gauge_readings)."""
     from nn import images
     from nn import seed001_experiments as ex
-    design = lambda c: images.species_design(inputs[c]["species"], inputs[c]["fines_share"], ex.SPECIES_DEGREE)  # noqa: E731
-    y = np.concatenate([nrrp[c] for c in train])
-    truth = nrrp[case][k:]
-    fill = images.fill_level_nrrp(np.concatenate([inputs[c]["fill"] for c in train]), y, inputs[case]["fill"][k:])
-    species = images.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])
-    return {"fill_level": images.scores(truth, fill)["relative_error"], "species": images.scores(truth, species)["relative_error"]}
+    return {g: images.scores(nrrp[case][k:], v)["relative_error"]
+            for g, v in ex.gauge_readings(case, train, inputs, nrrp, k).items()}
 
 
 def main() -> int:

@@ -251,12 +251,10 @@ def predict(model: torch.nn.Module, x: np.ndarray, scaling: dict, batch: int = 6
 
 def case_mass_and_size(attrs: dict) -> tuple[float, float, float]:
     """(total mass kg, mean diameter m, solid density) of a stored Table 1 case from its attributes."""
-    from pydem.rigs.table1 import TABLE1, species_counts
-    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[attrs["case"]]
-    ds, dl = dd[0] / 1000.0, dd[1] / 1000.0
-    nf, nc = species_counts(n, ds, dl, phi)
-    mass = rho * math.pi / 6.0 * (nf * ds ** 3 + nc * dl ** 3)
-    return mass, phi * ds + (1.0 - phi) * dl, float(rho)
+    from pydem.rigs.table1 import TABLE1, solid_volume
+    row = TABLE1[attrs["case"]]
+    phi, dd, rho = row[3], row[9], row[10]
+    return rho * solid_volume(row), (phi * dd[0] + (1.0 - phi) * dd[1]) / 1000.0, float(rho)
 
 
 def beverloo_discharge(train: dict[str, float], attrs: dict[str, dict], slot: float = 0.054, length: float = 0.04):
@@ -309,7 +307,7 @@ def species_fill(frames: np.ndarray) -> np.ndarray:
     coarse ones, can show (pydem.frames.species_masks), each over its case's first frame's —
     how much of each species the front view still shows."""
     from pydem.frames import species_masks
-    counts = np.concatenate([species_masks(frames[i:i + 256]).sum(axis=(-2, -1)) for i in range(0, len(frames), 256)])
+    counts = species_masks(frames).sum(axis=(-2, -1))
     return counts / np.maximum(counts[:1], 1.0)
 
 

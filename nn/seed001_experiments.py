@@ -308,15 +308,19 @@ def gauge_rows(case: str, gauges: dict, data: dict, folds: list[str], k: int) ->
     (images.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
     per packing erred least on the 1 ms frame set, 2026-11-28). Their scores and readings."""
     same = [c for c in gauges if _packing(c) == _packing(case) and _fold(c) in pretraining_folds(_fold(case), folds)]
-    g, row = gauges[case], {}
-    if same:
-        design = lambda c: images.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
-        row["fill_level"] = images.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in same]),
-                                                   np.concatenate([data[c].nrrp for c in same]), g["fill"][k:])
-        row["species"] = images.species_gauge_nrrp(np.concatenate([design(c) for c in same]),
-                                                   np.concatenate([data[c].nrrp for c in same]), design(case)[k:])
+    row = gauge_readings(case, same, gauges, {c: data[c].nrrp for c in same + [case]}, k) if same else {}
     truth = data[case].nrrp[k:]
     return {name: images.scores(truth, v) for name, v in row.items()} | {f"{name}_nrrp": v.tolist() for name, v in row.items()}
+
+
+def gauge_readings(case: str, train: list[str], gauges: dict, nrrp: dict, k: int) -> dict:
+    """{gauge: the case's NRRP from frame k on} with both gauges calibrated on `train`'s whole
+    discharges (gauges: gauge_inputs; nrrp: each training case's NRRP series)."""
+    design = lambda c: images.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
+    y = np.concatenate([nrrp[c] for c in train])
+    return {"fill_level": images.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in train]), y,
+                                                 gauges[case]["fill"][k:]),
+            "species": images.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])}
 
 
 def _save(path: Path, res: dict):
