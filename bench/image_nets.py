@@ -1,5 +1,5 @@
 """Seed 001's image networks on this machine's CPU: training throughput (frames per second
-through a forward and backward pass with Adam, as nn.images.fit trains them) and inference
+through a forward and backward pass with Adam, as nn.training.fit trains them) and inference
 latency per frame (one frame alone, and per frame in batches), on 1 and 2 torch threads, at the
 2-core runs' 64 x 64 input and the seed's 224 x 224.
 

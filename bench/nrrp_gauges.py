@@ -1,7 +1,7 @@
 """The image gauges beside a finished CNN-LSTM `process` run (pretrained protocol), without
 training anything: for every case the NRRP after its first 20 % of frames as the fill-level
 gauge and the species gauge read it, each calibrated on the cases in the folds the case's
-network pretrained on (nn.seed001_experiments.gauge_rows), scored like the network — for runs
+network pretrained on (pydem.seed001.experiments.gauge_rows), scored like the network — for runs
 made before the gauges were part of `process`, or on another machine. Beside them, the same
 gauges fitted on the case's own whole discharge (`*_own`: quintics; what no reader of a new
 hopper has): how well one discharge's frames fix its own count, against how well a law carries
@@ -24,9 +24,9 @@ sys.path.insert(0, str(ROOT))
 
 
 def main() -> int:
-    from nn import images
-    from nn import seed001_experiments as ex
-    from pydem.frames import FrameStore
+    from pydem.seed001 import frame_data
+    from pydem.seed001 import experiments as ex
+    from pydem.seed001.store import FrameStore
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--store", required=True)
     ap.add_argument("--size", type=int, default=64, help="frame side, as the process run used")
@@ -40,9 +40,9 @@ def main() -> int:
     if st["protocol"] != "pretrained":
         raise SystemExit(f"{args.process}: protocol {st['protocol']!r}; the gauge is calibrated on pretraining cases")
     cases = FrameStore(args.store).cases()
-    data = {c: images.load_frames(args.store, cases=[c], size=args.size) for c in cases}
+    data = {c: frame_data.load_frames(args.store, cases=[c], size=args.size) for c in cases}
     gauges = ex.gauge_inputs(args.store, cases, args.size)
-    folds = sorted({ex._fold(c) for c in cases})
+    folds = sorted({ex.fold_of(c) for c in cases})
     out = {"store": args.store, "size": args.size, "process": args.process, "cases": {}, "per_packing": {}}
     for c in cases:
         k = ex.first_part(len(data[c].x), st["fraction"], st["window"])
@@ -53,7 +53,7 @@ def main() -> int:
                                                                        "baseline": run["cases"][c]["baseline"]}
         print(f"{c}: " + "  ".join(f"{g} {r['relative_error']:.3f}" for g, r in out["cases"][c].items()))
     for pk in ex.PACKINGS:
-        rows = [r for c, r in out["cases"].items() if ex._packing(c) == pk]
+        rows = [r for c, r in out["cases"].items() if ex.packing_of(c) == pk]
         out["per_packing"][pk] = {key: float(np.mean([r[key]["relative_error"] for r in rows]))
                                   for key in rows[0]}
         print(f"{pk}: " + ", ".join(f"{k} {v:.3f}" for k, v in out["per_packing"][pk].items()))
@@ -65,20 +65,20 @@ def main() -> int:
 
 def own_fits(g: dict, nrrp: np.ndarray, k: int, degree: int = 5) -> dict:
     """Both gauges fitted on the case's whole discharge and scored on its frames from k on."""
-    from nn import images
-    design = images.species_design(g["species"], g["fines_share"], degree)
-    return {"fill_level_own": images.scores(nrrp[k:], images.fill_level_nrrp(g["fill"], nrrp, g["fill"], degree)[k:]),
-            "species_own": images.scores(nrrp[k:], images.species_gauge_nrrp(design, nrrp, design)[k:])}
+    from pydem.seed001 import baselines, frame_data
+    design = baselines.species_design(g["species"], g["fines_share"], degree)
+    return {"fill_level_own": frame_data.scores(nrrp[k:], baselines.fill_level_nrrp(g["fill"], nrrp, g["fill"], degree)[k:]),
+            "species_own": frame_data.scores(nrrp[k:], baselines.species_gauge_nrrp(design, nrrp, design)[k:])}
 
 
 def figure(path: str, gauges: dict, data: dict):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from nn.seed001_experiments import PACKINGS, _packing
+    from pydem.seed001.experiments import PACKINGS, packing_of
     fig, axes = plt.subplots(5, 5, figsize=(15, 13), sharey=True)
     for row, pk in zip(axes, PACKINGS):
-        for ax, c in zip(row, [c for c in gauges if _packing(c) == pk]):
+        for ax, c in zip(row, [c for c in gauges if packing_of(c) == pk]):
             g, i = gauges[c], np.arange(len(data[c].nrrp))
             ax.plot(i, data[c].nrrp, "k-", lw=1.5, label="NRRP (DEM count)")
             ax.plot(i, g["fill"], "C2-", lw=0.8, label="grey fill")

@@ -1,5 +1,5 @@
 """Would more hoppers carry the image-to-count law? The image gauges of `process`
-(nn.seed001_experiments.gauge_rows) read the five Table 1 cases of a packing after calibrating on
+(pydem.seed001.experiments.gauge_rows) read the five Table 1 cases of a packing after calibrating on
 its three pretraining-fold cases; here they are calibrated again with M more hoppers of the same
 packing added, drawn like Table 1's, and the errors compared — of each gauge, and of the one a
 user would pick by leave-one-hopper-out on the training hoppers (`chosen`).
@@ -45,7 +45,7 @@ def run_one(name: str, row: tuple, packing: str, frame_interval: float):
 
 
 def run(args) -> int:
-    from pydem.frames import FrameStore
+    from pydem.seed001.store import FrameStore
     from pydem.rigs.table1 import draw_like_table1
     store = FrameStore(args.store)
     rows = draw_like_table1(args.packing, args.hoppers, args.seed)
@@ -66,9 +66,9 @@ def run(args) -> int:
 
 
 def evaluate(args) -> int:
-    from nn import seed001_experiments as ex
-    from pydem.frames import FrameStore
-    table1 = [c for c in FrameStore(args.table1).cases() if ex._packing(c) == args.packing]
+    from pydem.seed001 import experiments as ex
+    from pydem.seed001.store import FrameStore
+    table1 = [c for c in FrameStore(args.table1).cases() if ex.packing_of(c) == args.packing]
     extra_store = FrameStore(args.store)
     extra = extra_store.cases()
     inputs = ex.gauge_inputs(args.table1, table1, args.size)
@@ -79,11 +79,11 @@ def evaluate(args) -> int:
         row = json.loads(d["row"])
         rows[c], nrrp[c] = tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]), d["nrrp"]
     inputs |= ex.gauge_inputs(args.store, extra, args.size, rows)
-    folds = sorted({ex._fold(c) for c in table1})
+    folds = sorted({ex.fold_of(c) for c in table1})
     out = {"packing": args.packing, "size": args.size, "extra": extra, "cases": {}}
     for case in table1:
         k = ex.first_part(len(nrrp[case]), 0.2, 8)
-        base = [c for c in table1 if ex._fold(c) in ex.pretraining_folds(ex._fold(case), folds)]
+        base = [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)]
         row = {}
         for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra)):
             row[label] = calibrated(case, inputs, nrrp, train, k)
@@ -102,7 +102,7 @@ def evaluate(args) -> int:
 def chosen_gauge(inputs: dict, nrrp: dict, train: list[str]) -> str:
     """The gauge a user would pick from the training hoppers alone: the one whose error, each
     hopper read by a gauge calibrated on the others (from its first 20 % on), is smaller."""
-    from nn import seed001_experiments as ex
+    from pydem.seed001 import experiments as ex
     errs = [calibrated(c, inputs, nrrp, [t for t in train if t != c], ex.first_part(len(nrrp[c]), 0.2, 8))
             for c in train]
     return min(ex.GAUGES, key=lambda g: np.mean([e[g] for e in errs]))
@@ -110,10 +110,10 @@ def chosen_gauge(inputs: dict, nrrp: dict, train: list[str]) -> str:
 
 def calibrated(case: str, inputs: dict, nrrp: dict, train: list[str], k: int) -> dict:
     """Relative errors of both gauges on the case from frame k, calibrated on `train`
-    (nn.seed001_experiments.gauge_readings)."""
-    from nn import images
-    from nn import seed001_experiments as ex
-    return {g: images.scores(nrrp[case][k:], v)["relative_error"]
+    (pydem.seed001.experiments.gauge_readings)."""
+    from pydem.seed001 import frame_data
+    from pydem.seed001 import experiments as ex
+    return {g: frame_data.scores(nrrp[case][k:], v)["relative_error"]
             for g, v in ex.gauge_readings(case, train, inputs, nrrp, k).items()}
 
 

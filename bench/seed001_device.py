@@ -1,7 +1,7 @@
 """Seed 001's image experiments on a GPU machine, where pydem's compiled binding is usually not
 built (another Python, no HDF5 headers): the image networks need only torch, h5py and numpy, so
 this runner imports pydem's pure-Python modules (the frame store, Table 1) without the binding
-and then runs `pydem images`' own command line (nn/seed001.py) with the same arguments.
+and then runs `pydem images`' own command line (pydem/seed001/cli.py) with the same arguments.
 The seed-scale comparison of docs/seed001.md (224 x 224, every frame):
 
     python3 bench/seed001_device.py compare --store data/seed001/frames_full.h5 --out OUT \\
@@ -23,7 +23,7 @@ sys.path.insert(0, str(ROOT))
 
 def import_without_binding():
     """pydem's package __init__ loads the compiled binding; where it cannot, register pydem and
-    pydem.rigs as bare packages so their pure-Python modules (frames, table1) still import."""
+    pydem.rigs as bare packages so their pure-Python modules (the seed001 study, rigs.table1) still import."""
     try:
         if os.environ.get("SEED001_NO_BINDING"):  # lets the CPU machines test this path
             raise ImportError("SEED001_NO_BINDING set")
@@ -40,7 +40,7 @@ def import_without_binding():
 
 def main(argv=None) -> int:
     import_without_binding()
-    from nn.seed001 import main as seed001
+    from pydem.seed001.cli import main as seed001
     return seed001(argv, prog="bench/seed001_device.py")
 
 

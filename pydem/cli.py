@@ -8,35 +8,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
+from .cli_inputs import check_writable
 from .errors import DemError
+from .progress import RunProgress
 from .rigs import RIGS, ConfigError, load
 from .rigs.config import describe
-
-
-class ProgressLine:
-    """Simulated time, rate and ETA on one refreshed line (stderr), at most 4 times a second."""
-
-    def __init__(self, stream=sys.stderr):
-        self.stream, self.last = stream, 0.0
-
-    def __call__(self, sim_time: float, planned: float, info: dict):
-        now = time.perf_counter()
-        if now - self.last < 0.25:
-            return
-        self.last = now
-        wall = max(info.get("wall", 0.0), 1e-9)
-        rate = sim_time / wall
-        eta = (planned - sim_time) / rate if rate > 0 and planned > sim_time else 0.0
-        self.stream.write(f"\r  t = {sim_time:7.3f} s of <= {planned:.2f} s   {rate:8.4f} s/s   "
-                          f"{info.get('steps', 0) / wall / 1e3:7.1f} k steps/s   {info.get('particles', 0)} particles   "
-                          f"{info.get('threads', 1)} thread(s)   "
-                          f"ETA <= {eta:6.0f} s ")
-        self.stream.flush()
-
-    def done(self):
-        self.stream.write("\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -57,20 +34,21 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--checkpoint-every", type=float, default=600.0, help="seconds of wall time between checkpoints")
     rig.add_argument("--list", action="store_true", help="list the keys of this rig and exit")
     rig.add_argument("--quiet", action="store_true", help="no progress line")
-    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_images, cli_locus
+    from . import cli_calibrate, cli_campaign, cli_compare, cli_diagnose, cli_locus
+    from .seed001 import command as images_command
     cli_campaign.add_parser(sub)
     cli_compare.add_parser(sub)
     cli_diagnose.add_parser(sub)
     cli_calibrate.add_parser(sub)
     cli_locus.add_parser(sub)
-    cli_images.add_parser(sub)
+    images_command.add_parser(sub)
     return ap
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["images"]:
-        from .cli_images import forward
+        from .seed001.command import forward
         return forward(argv[1:])
     args = build_parser().parse_args(argv)
     if hasattr(args, "func"):
@@ -98,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     extra = {}
     if args.checkpoint:
         extra = {"checkpoint": args.checkpoint, "checkpoint_every": args.checkpoint_every}
-    progress = None if args.quiet else ProgressLine()
+    progress = None if args.quiet else RunProgress()
     try:
         result = cls(cfg).run(seed=args.seed, frames_dir=args.frames, progress=progress, vtk_dir=args.vtk, **extra)
     except (DemError, ValueError) as exc:
@@ -128,20 +106,6 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         print(f"result written to {args.out}")
     return 0
-
-
-def check_writable(path: str, directory: bool):
-    """Raises OSError naming the path when it cannot be written (a directory is created)."""
-    import os
-    from pathlib import Path
-    p = Path(path)
-    d = p if directory else (p.parent if str(p.parent) else Path("."))
-    if directory:
-        p.mkdir(parents=True, exist_ok=True)
-    if not d.is_dir():
-        raise OSError(f"{d}: no such directory")
-    if not os.access(d, os.W_OK) or (p.exists() and not directory and not os.access(p, os.W_OK)):
-        raise OSError(f"{path}: permission denied")
 
 
 if __name__ == "__main__":

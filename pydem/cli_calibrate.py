@@ -11,9 +11,10 @@ import sys
 import time
 from pathlib import Path
 
+from .cli_inputs import add_common, load_inputs
+
 
 def add_parser(sub):
-    from .cli_diagnose import add_common
     p = sub.add_parser("calibrate", help="posterior of the micro parameters, seed 000's admissible set, exported nets")
     add_common(p, "build/calibration", 2)
     p.add_argument("--window", type=float, default=0.05, help="seed 000's relative acceptance window (default 0.05)")
@@ -36,7 +37,6 @@ def export_nets(nets: dict, directory: Path) -> list[Path]:
 def main(args) -> int:
     from .calibration import report
     from .calibration.calibrate import calibrate
-    from .cli_diagnose import load_inputs
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     if args.samples < 1 or not 0 < args.window < 1:
@@ -59,8 +59,8 @@ def main(args) -> int:
                "stores": setup.store_provenance(), "window": args.window, "samples": args.samples}
     if args.confirm:
         from .calibration.confirm import confirm
-        from .cli import ProgressLine
-        context["confirm"] = confirm(setup, c.fit, obs, args.threads, say, ProgressLine())
+        from .progress import RunProgress
+        context["confirm"] = confirm(setup, c.fit, obs, args.threads, say, RunProgress())
     path = report.write_calibration(c, out, context)
     from .calibration import material_card
     material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates), out)

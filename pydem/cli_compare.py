@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 import sys
 
+from .cli_inputs import load_inputs
+
 
 def add_parser(sub):
     from .calibration.setup import DEFAULT_STORES
@@ -36,7 +38,6 @@ def _params(text: str) -> dict[str, float]:
 
 def main(args) -> int:
     from .calibration.compare import dem_rows, overall, surrogate_rows
-    from .cli_diagnose import load_inputs
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     if bool(args.params) == bool(args.dem):
         print("pydem compare: give --params (the surrogates at a parameter set) or --dem result files", file=sys.stderr)

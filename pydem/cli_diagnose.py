@@ -8,36 +8,7 @@ from __future__ import annotations
 import sys
 import time
 
-
-def add_common(p, out: str, threads: int):
-    """The arguments `pydem diagnose` and `pydem calibrate` share."""
-    from .calibration.setup import DEFAULT_STORES
-    p.add_argument("measurements", help="measurement file (docs/measurements.md)")
-    p.add_argument("--material", required=True)
-    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
-                   help="campaign stores: one per rig, and others of a rig pooled into its surrogates (default: the shipped diagnosis stores)")
-    p.add_argument("--out", default=out)
-    p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
-    p.add_argument("--threads", type=int, default=threads, help=f"threads of the confirming runs (default {threads})")
-    p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
-
-
-def load_inputs(args, command: str, say):
-    """(setup, observations, rows left out), or None after printing why not (exit status 2)."""
-    from .calibration.quantities import ObservationError
-    from .calibration.setup import load_setup, observations_from_file
-    from .campaign import StoreError
-    from .measurements import MeasurementError, load as load_measurements
-    try:
-        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
-        setup = load_setup(args.stores, say, getattr(args, "retrain", False))
-        obs, skipped = observations_from_file(args.measurements, args.material, setup)
-    except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
-        print(f"pydem {command}: {exc}", file=sys.stderr)
-        return None
-    for line in skipped:
-        say(f"  left out: {line}")
-    return setup, obs, skipped
+from .cli_inputs import add_common, load_inputs
 
 
 def add_parser(sub):
@@ -68,9 +39,9 @@ def main(args) -> int:
                "stores": setup.store_provenance(), "libdem_of_stores": setup.physics}
     if args.confirm:
         from .calibration.confirm import confirm
-        from .cli import ProgressLine
+        from .progress import RunProgress
         fit = d.after if d.after is not None else d.base
-        context["confirm"] = confirm(setup, fit, obs, args.threads, say, ProgressLine())
+        context["confirm"] = confirm(setup, fit, obs, args.threads, say, RunProgress())
     path = report.write(d, args.out, context)
     from .calibration import material_card  # the final model: with the effect when one was added
     material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,

@@ -11,35 +11,12 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from ._libdem import ffi, lib
+from .cdata import as_c_array, c_definition, c_pointer
 from .errors import DemInvalidArgument, DemUnknownError, check
 
 ROLLING_MODELS = {"cdt": lib.DEM_ROLLING_CDT, "epsd": lib.DEM_ROLLING_EPSD, "epsd2": lib.DEM_ROLLING_EPSD2}
 REGIONS = {"box": lib.DEM_REGION_BOX, "cylinder": lib.DEM_REGION_CYLINDER, "annular_sector": lib.DEM_REGION_ANNULAR_SECTOR}
 COLOR_MODES = {"material": lib.DEM_COLOR_MATERIAL, "scalar": lib.DEM_COLOR_SCALAR, "grey": lib.DEM_COLOR_GREY}
-
-
-def _array(values, dtype, shape_tail: tuple, name: str, n: int | None = None) -> np.ndarray:
-    """C-contiguous array of dtype with shape (n, *shape_tail); no copy when already so. An
-    integer dtype refuses values that are not whole numbers (a triangle index 2.5 is an error,
-    never truncated)."""
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        raw = np.asarray(values)
-        if raw.dtype.kind not in "iub":
-            f = raw.astype(np.float64)
-            if not np.all(np.isfinite(f)) or np.any(f != np.round(f)):
-                raise DemInvalidArgument(f"{name} must be whole numbers, got {f[(~np.isfinite(f)) | (f != np.round(f))][:3]}",
-                                         "DEM_ERR_INVALID_ARGUMENT")
-    a = np.ascontiguousarray(values, dtype=dtype)
-    if shape_tail and a.ndim == 1 and a.size == int(np.prod(shape_tail)) and n in (None, 1):
-        a = a.reshape((1, *shape_tail))
-    if a.shape[1:] != shape_tail or (n is not None and a.shape[0] != n):
-        want = f"({n if n is not None else 'n'}{''.join(', ' + str(s) for s in shape_tail)})"
-        raise DemInvalidArgument(f"{name} must have shape {want}, got {a.shape}", "DEM_ERR_INVALID_ARGUMENT")
-    return a
-
-
-def _ptr(a: np.ndarray, ctype: str):
-    return ffi.from_buffer(ctype, a)
 
 
 def effects() -> list[dict]:
@@ -55,22 +32,6 @@ def effects() -> list[dict]:
             params.append({"name": ffi.string(pn[0]).decode(), "unit": ffi.string(unit[0]).decode(), "neutral": neutral[0]})
         out.append({"name": ffi.string(name[0]).decode(), "summary": ffi.string(summary[0]).decode(), "params": params})
     return out
-
-
-def c_definition(maker, ctype: str, **given):
-    """A libdem definition struct: the library's defaults (its dem_default_*_def maker: libdem
-    owns every default), then the values given; None keeps the default."""
-    s = ffi.new(ctype, maker())
-    for key, value in given.items():
-        if value is None:
-            continue
-        field = getattr(s, key)
-        if isinstance(field, ffi.CData) and ffi.typeof(field).kind == "array":  # lo, hi, gravity, ...
-            for a, x in enumerate(value):
-                field[a] = x
-        else:
-            setattr(s, key, value)
-    return s
 
 
 # dem_contact's layout (include/dem/types.h); its size is checked against the C struct at import
@@ -220,22 +181,22 @@ class Domain:
     # ---- particles -------------------------------------------------------------------------
     def add_particles(self, positions, radii, materials, velocities=None, angular_velocities=None) -> np.ndarray:
         """Adds n spheres (all or nothing); returns their ids (int64)."""
-        pos = _array(positions, np.float64, (3,), "positions")
+        pos = as_c_array(positions, np.float64, (3,), "positions")
         n = pos.shape[0]
-        rad = _array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)), np.float64, (), "radii", n)
-        mat = _array(np.broadcast_to(np.asarray(materials, dtype=np.int32), (n,)), np.int32, (), "materials", n)
-        vel = None if velocities is None else _array(velocities, np.float64, (3,), "velocities", n)
-        ang = None if angular_velocities is None else _array(angular_velocities, np.float64, (3,), "angular_velocities", n)
+        rad = as_c_array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)), np.float64, (), "radii", n)
+        mat = as_c_array(np.broadcast_to(np.asarray(materials, dtype=np.int32), (n,)), np.int32, (), "materials", n)
+        vel = None if velocities is None else as_c_array(velocities, np.float64, (3,), "velocities", n)
+        ang = None if angular_velocities is None else as_c_array(angular_velocities, np.float64, (3,), "angular_velocities", n)
         ids = np.empty(n, dtype=np.int64)
-        self._check(lib.dem_particles_add(self._d, n, _ptr(pos, "double[]"), _ptr(rad, "double[]"), _ptr(mat, "dem_material[]"),
-                                          ffi.NULL if vel is None else _ptr(vel, "double[]"),
-                                          ffi.NULL if ang is None else _ptr(ang, "double[]"),
-                                          _ptr(ids, "int64_t[]")))
+        self._check(lib.dem_particles_add(self._d, n, c_pointer(pos, "double[]"), c_pointer(rad, "double[]"), c_pointer(mat, "dem_material[]"),
+                                          ffi.NULL if vel is None else c_pointer(vel, "double[]"),
+                                          ffi.NULL if ang is None else c_pointer(ang, "double[]"),
+                                          c_pointer(ids, "int64_t[]")))
         return ids
 
     def remove_particles(self, ids: Iterable[int]):
-        a = _array(ids, np.int64, (), "ids")
-        self._check(lib.dem_particles_remove(self._d, a.shape[0], _ptr(a, "int64_t[]")))
+        a = as_c_array(ids, np.int64, (), "ids")
+        self._check(lib.dem_particles_remove(self._d, a.shape[0], c_pointer(a, "int64_t[]")))
 
     def __len__(self) -> int:
         return int(lib.dem_particle_count(self._d))
@@ -244,7 +205,7 @@ class Domain:
         n = len(self)
         out = np.empty((n, width) if width else (n,), dtype=dtype)
         if n:
-            self._check(fn(self._d, _ptr(out, "int64_t[]" if dtype == np.int64 else "double[]"), n))
+            self._check(fn(self._d, c_pointer(out, "int64_t[]" if dtype == np.int64 else "double[]"), n))
         return out
 
     @property
@@ -261,8 +222,8 @@ class Domain:
 
     @velocities.setter
     def velocities(self, v):
-        a = _array(v, np.float64, (3,), "velocities", len(self))
-        self._check(lib.dem_particles_set_velocities(self._d, _ptr(a, "double[]")))
+        a = as_c_array(v, np.float64, (3,), "velocities", len(self))
+        self._check(lib.dem_particles_set_velocities(self._d, c_pointer(a, "double[]")))
 
     @property
     def angular_velocities(self) -> np.ndarray:
@@ -270,8 +231,8 @@ class Domain:
 
     @angular_velocities.setter
     def angular_velocities(self, w):
-        a = _array(w, np.float64, (3,), "angular_velocities", len(self))
-        self._check(lib.dem_particles_set_angular_velocities(self._d, _ptr(a, "double[]")))
+        a = as_c_array(w, np.float64, (3,), "angular_velocities", len(self))
+        self._check(lib.dem_particles_set_angular_velocities(self._d, c_pointer(a, "double[]")))
 
     @property
     def forces(self) -> np.ndarray:
@@ -392,8 +353,8 @@ class Domain:
         r.color_mode = COLOR_MODES[color]
         keep = None
         if color == "scalar":
-            keep = _array(scalar, np.float64, (), "scalar", len(self))
-            r.scalar = _ptr(keep, "double[]")
+            keep = as_c_array(scalar, np.float64, (), "scalar", len(self))
+            r.scalar = c_pointer(keep, "double[]")
             lo, hi = scalar_range if scalar_range is not None else (float(keep.min(initial=0)), float(keep.max(initial=1)))
             r.scalar_min, r.scalar_max = lo, hi
         for a in range(3):
@@ -406,7 +367,7 @@ class Domain:
         ((right_lo, right_hi), (up_lo, up_hi)) in metres, None for the domain's box."""
         r, keep = self._render_def(width, height, view_axis, window, color, scalar, scalar_range, walls, background)
         img = np.empty((height, width, 3), dtype=np.uint8)
-        self._check(lib.dem_render_rgb(self._d, ffi.new("dem_render_def *", r), _ptr(img, "unsigned char[]")))
+        self._check(lib.dem_render_rgb(self._d, ffi.new("dem_render_def *", r), c_pointer(img, "unsigned char[]")))
         del keep
         return img
 

@@ -7,7 +7,7 @@ from typing import Sequence
 import numpy as np
 
 from ._libdem import ffi, lib
-from .domain import _array, _ptr
+from .cdata import as_c_array, c_definition, c_pointer
 
 
 class PlaneWall:
@@ -19,7 +19,6 @@ class PlaneWall:
 
     @classmethod
     def _create(cls, domain, axis, side, position, material, velocity):
-        from .domain import c_definition
         w = c_definition(lib.dem_default_plane_wall_def, "dem_plane_wall_def *", axis=axis, side=side,
                          position=position, material=None if material is None else [int(material)], velocity=velocity)
         out = ffi.new("dem_plane_wall *")
@@ -65,10 +64,10 @@ class MeshWall:
             domain._check(lib.dem_mesh_wall_add_stl(domain._d, os.fsencode(source), mdp, out))
         else:
             vertices, triangles = source
-            v = _array(vertices, np.float64, (3,), "vertices")
-            t = _array(triangles, np.int32, (3,), "triangles")
-            domain._check(lib.dem_mesh_wall_add(domain._d, v.shape[0], _ptr(v, "double[]"), t.shape[0],
-                                                _ptr(t, "int32_t[]"), mdp, out))
+            v = as_c_array(vertices, np.float64, (3,), "vertices")
+            t = as_c_array(triangles, np.int32, (3,), "triangles")
+            domain._check(lib.dem_mesh_wall_add(domain._d, v.shape[0], c_pointer(v, "double[]"), t.shape[0],
+                                                c_pointer(t, "int32_t[]"), mdp, out))
         return cls(domain, out.index)
 
     def info(self) -> dict:
@@ -83,13 +82,13 @@ class MeshWall:
     @property
     def vertices(self) -> np.ndarray:
         out = np.empty((self.info()["vertex_count"], 3))
-        self.domain._check(lib.dem_mesh_wall_get_vertices(self.domain._d, [self.index], _ptr(out, "double[]"), len(out)))
+        self.domain._check(lib.dem_mesh_wall_get_vertices(self.domain._d, [self.index], c_pointer(out, "double[]"), len(out)))
         return out
 
     @property
     def triangles(self) -> np.ndarray:
         out = np.empty((self.info()["triangle_count"], 3), dtype=np.int32)
-        self.domain._check(lib.dem_mesh_wall_get_triangles(self.domain._d, [self.index], _ptr(out, "int32_t[]"), len(out)))
+        self.domain._check(lib.dem_mesh_wall_get_triangles(self.domain._d, [self.index], c_pointer(out, "int32_t[]"), len(out)))
         return out
 
     def set_motion(self, velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] | None = None,
@@ -147,7 +146,7 @@ class MeshWall:
 
     def triangle_forces(self) -> np.ndarray:
         out = np.empty((self.info()["triangle_count"], 3))
-        self.domain._check(lib.dem_mesh_wall_triangle_forces(self.domain._d, [self.index], _ptr(out, "double[]"), len(out)))
+        self.domain._check(lib.dem_mesh_wall_triangle_forces(self.domain._d, [self.index], c_pointer(out, "double[]"), len(out)))
         return out
 
     def stress(self, normal: Sequence[float], area: float) -> tuple[float, float]:

@@ -3,15 +3,14 @@ tables, plots as PNG files beside it) and `diagnosis.json`. Renders only: every 
 from the Diagnosis object."""
 from __future__ import annotations
 
-import base64
 import html
-import io
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
+from .. import report_page as page
 from ..rigs.result import strict_json
 from .diagnose import ALPHA, Diagnosis
 
@@ -48,14 +47,6 @@ def _limits(info: dict) -> str:
     if "below" not in info:
         return f"below {hi:.3g}"
     return f"{lo:.3g}–{hi:.3g}"
-
-
-def _png(fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    import matplotlib.pyplot as plt
-    plt.close(fig)
-    return buf.getvalue()
 
 
 def _axis_condition(q) -> str | None:
@@ -119,7 +110,7 @@ def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.
         ax.set_visible(False)
     fig.suptitle("measured (bars: stated uncertainty) vs model (bands: ±1 sigma of measured − model at that "
                  "model's estimate: max(stated, seed scatter) and the nets' error)", fontsize=9)
-    return _png(fig)
+    return page.png(fig)
 
 
 def plot_parameters(fit, window: dict | None) -> bytes:
@@ -155,7 +146,7 @@ def plot_parameters(fit, window: dict | None) -> bytes:
     note = "" if n_adm is None else (f"; {n_adm:,} of {window['samples']:,} combinations within ±{100 * window['window']:g} %"
                                       if n_adm else f"; no combination within ±{100 * window['window']:g} % of every value")
     fig.suptitle(f"parameters over the campaign box{note}", fontsize=10)
-    return _png(fig)
+    return page.png(fig)
 
 
 def nets_section(nets: dict) -> tuple[str, str, str]:
@@ -164,7 +155,7 @@ def nets_section(nets: dict) -> tuple[str, str, str]:
     rows = [[q.key, n.runs, ", ".join(x.split(".")[-1] for x in n.input_names), _g(n.r2, ".3f"), _g(n.rmse, ".3g"),
              _g(n.seed_sd, ".3g") + ("" if math.isfinite(n.scatter) else " (all of the RMSE)"), _g(n.net_error, ".3g")]
             for q, n in sorted(nets.items(), key=lambda kv: kv[0].key)]
-    md, h = _table(rows, ["quantity", "rows", "inputs", "CV R²", "CV RMSE", "seed scatter", "net error"])
+    md, h = page.table(rows, ["quantity", "rows", "inputs", "CV R²", "CV RMSE", "seed scatter", "net error"])
     return "Surrogates", md, h
 
 
@@ -188,16 +179,8 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     ax.legend(fontsize=7)
     if not names:
         ax.text(0.5, 0.5, "no candidate covered by these campaigns", ha="center", transform=ax.transAxes)
-    out["candidates.png"] = _png(fig)
+    out["candidates.png"] = page.png(fig)
     return out
-
-
-def _table(rows: list[list], header: list[str]) -> tuple[str, str]:
-    md = "| " + " | ".join(header) + " |\n|" + "---|" * len(header) + "\n"
-    md += "".join("| " + " | ".join(map(str, r)) + " |\n" for r in rows)
-    h = "<table><tr>" + "".join(f"<th>{html.escape(x)}</th>" for x in header) + "</tr>"
-    h += "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r) + "</tr>" for r in rows) + "</table>"
-    return md, h
 
 
 def _g(x, fmt=".4g"):
@@ -222,13 +205,13 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     if a:
         rows.append([f"with {d.effect or (d.candidates[0].effect + ' (not enough)')}", _g(a["chi2_per_dof"], ".2f"), a["dof"],
                      _g(a["p_value"], ".2g"), _g(a["rmse_relative"], ".3f"), _g(a["loco_rmse_relative"], ".3f")])
-    md, h = _table(rows, ["model", "chi^2/dof", "dof", "p-value", "RMSE of relative residuals",
+    md, h = page.table(rows, ["model", "chi^2/dof", "dof", "p-value", "RMSE of relative residuals",
                           "leave-one-condition-out RMSE"])
     sections.append(("Before and after", md, h))
     rows = [[c.effect, c.parameter, _g(c.statistic, ".2f"), _g(c.p_value, ".2g"), _g(c.delta_bic, ".1f"),
              _g(c.score, ".2f"), f"{_g(c.estimate)} {c.unit}".strip(), f"{_g(c.neutral)} {c.unit}".strip()]
             for c in d.candidates]
-    md, h = _table(rows, ["candidate", "parameter", "LR statistic", "p-value", "dBIC", "score", "estimate", "neutral"])
+    md, h = page.table(rows, ["candidate", "parameter", "LR statistic", "p-value", "dBIC", "score", "estimate", "neutral"])
     extra = ""
     if d.not_covered:
         extra = f"\n\nNot covered by these campaigns: {', '.join(d.not_covered)}."
@@ -251,14 +234,14 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     if d.groups:
         names = list(d.groups[0]["estimate"])
         rows = [[g["condition"], g["rows"]] + [_g(g["estimate"][n], ".3g") for n in names] for g in d.groups]
-        md, h = _table(rows, ["condition group", "rows"] + names)
+        md, h = page.table(rows, ["condition group", "rows"] + names)
         sections.append(("Base model recalibrated per condition group (a parameter drifting with a condition points "
                          "at a missing effect)", md, h))
     if data["context"].get("confirm"):
         sections.append(confirm_section(data["context"]["confirm"]))
     if d.notes:
         sections.append(notes_section(d.notes))
-    return write_page(out, f"Diagnosis: {d.material}", sections, plots, head=2)
+    return page.write_page(out, f"Diagnosis: {d.material}", sections, plots, head=2)
 
 
 def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
@@ -273,7 +256,7 @@ def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
         return f"{n['test']} (limits × {n['limit_ratio']:.2f})" if n else "-"
     rows = [[name, f"{_g(info['neutral'])} {units.get(name, '')}".strip(), side(info.get("below"), info, "below"),
              side(info.get("above"), info, "above"), next_test(info)] for name, info in detectable.items()]
-    md, h = _table(rows, ["candidate", "neutral (base model)", "detectable below", "detectable above",
+    md, h = page.table(rows, ["candidate", "neutral (base model)", "detectable below", "detectable above",
                           "one more test that would lower the limits most"])
     any_info = next(iter(detectable.values()))
     needed = " or ".join(sorted({f"{i['signal_needed']:.1f}" for i in detectable.values()}))
@@ -290,7 +273,7 @@ def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
 def parameter_section(params: dict, window: dict | None, title: str) -> tuple[str, str, str]:
     rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
             for k, v in params.items()]
-    md, h = _table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
+    md, h = page.table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
     if window:
         line = (f"Seed 000's view: {window['admissible']:,} of {window['samples']:,} combinations of the box (scrambled "
                 f"Sobol, screened natively) predict every measured value within ±{100 * window['window']:g} %"
@@ -304,38 +287,19 @@ def parameter_section(params: dict, window: dict | None, title: str) -> tuple[st
 def residual_section(rows: list[dict], title: str) -> tuple[str, str, str]:
     table = [[r["label"], _g(r["measured"]), _g(r["u_measured"], ".3g"), _g(r["model"]), _g(r["sigma"], ".3g"),
               _g(r["z"], "+.2f")] for r in rows]
-    md, h = _table(table, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
+    md, h = page.table(table, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
     return title, md, h
 
 
 def confirm_section(rows: list[dict]) -> tuple[str, str, str]:
     table = [[r["label"], _g(r["measured"]), _g(r["dem"]), f"{100 * r['relative']:+.1f} %"] for r in rows]
-    md, h = _table(table, ["measurement", "measured", "DEM at the estimate", "(measured - DEM) / measured"])
+    md, h = page.table(table, ["measurement", "measured", "DEM at the estimate", "(measured - DEM) / measured"])
     return "Confirming DEM runs", md, h
 
 
 def notes_section(notes: list[str]) -> tuple[str, str, str]:
     return ("Notes", "\n".join(f"- {n}" for n in notes),
             "<ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in notes) + "</ul>")
-
-
-def write_page(out: Path, title: str, sections: list[tuple[str, str, str]], plots: dict[str, bytes], head: int) -> Path:
-    """report.md (plots as the PNG files beside it) and report.html (self-contained: plots
-    embedded after the first `head` sections)."""
-    md = f"# {title}\n\n" + "\n\n".join(f"## {t}\n\n{m}" for t, m, _ in sections)
-    md += "\n\n## Plots\n\n" + "\n\n".join(f"![{n[:-4]}]({n})" for n in plots) + "\n"
-    (out / "report.md").write_text(md)
-    imgs = "".join(f"<figure><img alt='{n}' src='data:image/png;base64,{base64.b64encode(p).decode()}'></figure>"
-                   for n, p in plots.items())
-    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>"
-            "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
-            "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
-            ".verdict{font-size:1.2em;background:#f4f4f0;padding:.6em}img{max-width:100%}</style></head><body>"
-            f"<h1>{html.escape(title)}</h1>" + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[:head])
-            + imgs + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[head:]) + "</body></html>")
-    path = out / "report.html"
-    path.write_text(page)
-    return path
 
 
 def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
@@ -367,10 +331,10 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
     names = data["correlation"]["names"] or []
     if names:
         rows = [[a] + [_g(v, "+.2f") for v in row] for a, row in zip(names, data["correlation"]["matrix"])]
-        md, h = _table(rows, ["correlation"] + names)
+        md, h = page.table(rows, ["correlation"] + names)
         sections.append(("Posterior correlations", md, h))
     if data["context"].get("confirm"):
         sections.append(confirm_section(data["context"]["confirm"]))
     if c.notes:
         sections.append(notes_section(c.notes))
-    return write_page(out, f"Calibration: {c.material}", sections, plots, head=2)
+    return page.write_page(out, f"Calibration: {c.material}", sections, plots, head=2)

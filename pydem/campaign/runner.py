@@ -2,7 +2,6 @@
 process pool (default) or on a Dask cluster; each finished run is saved to the store at once."""
 from __future__ import annotations
 
-import math
 import os
 import sys
 import time
@@ -11,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..progress import CampaignProgress
 from ..provenance import provenance
 from ..rigs import RIGS
 from .design import at_neutral, design_points
@@ -40,31 +40,6 @@ def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
 
 def sample_seed(campaign_seed: int, index: int) -> int:
     return int(np.random.SeedSequence([campaign_seed, index]).generate_state(1)[0])
-
-
-class Progress:
-    """done/total, rate, ETA and failures on one refreshed stderr line."""
-
-    def __init__(self, total: int, already: int, stream=sys.stderr, quiet: bool = False):
-        self.total, self.already, self.stream, self.quiet = total, already, stream, quiet
-        self.t0, self.done, self.failed = time.perf_counter(), 0, 0
-
-    def update(self, ok: bool):
-        self.done += 1
-        self.failed += 0 if ok else 1
-        if self.quiet:
-            return
-        el = time.perf_counter() - self.t0
-        rate = self.done / el if el > 0 else 0.0
-        left = self.total - self.already - self.done
-        eta = left / rate if rate > 0 else math.inf
-        self.stream.write(f"\r  {self.already + self.done}/{self.total} runs   {rate * 60:6.2f} runs/min   "
-                          f"ETA {eta / 60:6.1f} min   failures {self.failed} ")
-        self.stream.flush()
-
-    def close(self):
-        if not self.quiet and self.done:
-            self.stream.write("\n")
 
 
 def resolved_config(spec) -> dict:
@@ -195,7 +170,7 @@ class Campaign:
                 already = int(np.count_nonzero(s.status != 0) - np.count_nonzero(s.status[todo] != 0))
             else:
                 already = int((s.status == DONE).sum() + ((s.status == FAILED).sum() if not retry_failed else 0))
-            progress = Progress(already + len(todo), already, quiet=quiet)  # ETA of this invocation
+            progress = CampaignProgress(already + len(todo), already, quiet=quiet)  # ETA of this invocation
             args = {i: (spec_json, dict(zip(s.spec.names, map(float, s.params[i]))), int(s.seeds[i])) for i in todo}
             try:
                 if dask:
@@ -208,7 +183,7 @@ class Campaign:
         finally:
             s.unlock()
 
-    def _finish(self, i: int, out: dict, progress: Progress):
+    def _finish(self, i: int, out: dict, progress: CampaignProgress):
         if "error" in out:
             self.store.record_failure(i, out["error"], out["wall"])
         else:

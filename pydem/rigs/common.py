@@ -189,7 +189,7 @@ class Frames:
         self.dir = Path(frames_dir) if frames_dir else None
         from ..vtk import VtkSeries
         self.vtk = VtkSeries(vtk_dir) if vtk_dir else None
-        self.images = [] if images else None  # centre-cropped grey frames kept in memory (pydem.frames)
+        self.images = [] if images else None  # centre-cropped grey frames kept in memory (pydem.rigs.frames)
 
     def state(self) -> dict:
         """What a checkpoint keeps of the output (the VTK collections written so far)."""
@@ -208,7 +208,7 @@ class Frames:
         if self.vtk is not None:
             self.vtk.write(d)
         if self.images is not None:
-            from ..frames import crop_grey
+            from .frames import crop_grey
             self.images.append(crop_grey(d.render(**render)))
         if self.dir is None:
             return None

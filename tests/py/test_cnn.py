@@ -1,4 +1,4 @@
-"""Seed 001's image networks (nn/cnn.py) and their training and baselines (nn/images.py).
+"""Seed 001's image networks (nn/cnn.py) and their training (nn/training.py) and baselines (pydem/seed001).
 
 The four backbones are torchvision's architectures written again in plain torch: built for
 ImageNet (3 channels, 1000 outputs) each must have exactly torchvision's published parameter
@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 import torch
 
-from nn import cnn, images
+from nn import cnn, training
+from pydem.seed001 import baselines, frame_data
 
 
 @pytest.mark.parametrize("name, build, count", [
@@ -57,33 +58,33 @@ def test_training_lowers_the_loss_and_resumes_bitwise(tmp_path):
     x, y = blobs(160)
     xv, yv = blobs(40, seed=1)
     torch.manual_seed(0)  # the initial weights: the caller's
-    first = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2)
+    first = training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2)
     h = first["history"]
     assert h[-1]["loss"] < 0.5 * h[0]["loss"], h
     assert min(e["validation"] for e in h) < 0.5, h  # standardised: 1 is "predicts the mean"
     # a training killed after 3 epochs and resumed from its checkpoint ends where the whole one did
     ck = tmp_path / "fc.pt"
     torch.manual_seed(0)
-    images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=3, batch=16, lr=3e-4, seed=2, checkpoint=ck)
-    resumed = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2, checkpoint=ck)
+    training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=3, batch=16, lr=3e-4, seed=2, checkpoint=ck)
+    resumed = training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=3e-4, seed=2, checkpoint=ck)
     assert resumed["history"] == h
     with pytest.raises(ValueError, match="another training"):  # other settings: refused, not resumed
-        images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=1e-3, seed=2, checkpoint=ck)
+        training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=6, batch=16, lr=1e-3, seed=2, checkpoint=ck)
 
 
 def test_scores_by_hand():
-    s = images.scores(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 2.0]))
+    s = frame_data.scores(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 2.0]))
     assert s["mae"] == pytest.approx(0.5) and s["rmse"] == pytest.approx(math.sqrt(1.25 / 3))
     assert s["r2"] == pytest.approx(1 - 1.25 / 2.0) and s["relative_error"] == pytest.approx((0.25 + 1 / 3) / 3)
     # near the empty end (y below 10 % of its largest) rows count in MAE/RMSE/R^2, not in the relative error
-    s = images.scores(np.array([0.01, 1.0]), np.array([0.5, 1.5]))
+    s = frame_data.scores(np.array([0.01, 1.0]), np.array([0.5, 1.5]))
     assert s["relative_error"] == pytest.approx(0.5) and s["mae"] == pytest.approx(0.495)
 
 
 def test_constant_rate_baseline_on_a_steady_discharge():
     t = np.linspace(0.0, 2.0, 101)
     nrrp = np.clip(1.0 - 0.6 * t, 0.0, 1.0)  # a steady discharge, empty at t = 5/3 s
-    assert np.allclose(images.constant_rate_nrrp(t, nrrp), nrrp, atol=1e-12)
+    assert np.allclose(baselines.constant_rate_nrrp(t, nrrp), nrrp, atol=1e-12)
 
 
 def test_fill_level_gauge_recovers_a_cubic_reading_and_stays_in_0_1():
@@ -92,8 +93,8 @@ def test_fill_level_gauge_recovers_a_cubic_reading_and_stays_in_0_1():
     fill = np.linspace(0.2, 1.0, 50)
     law = lambda f: 0.1 + 0.3 * f + 0.8 * f ** 2 - 0.2 * f ** 3  # noqa: E731
     new = np.array([0.35, 0.5, 0.77])
-    assert np.allclose(images.fill_level_nrrp(fill, law(fill), new), law(new), atol=1e-12)
-    assert images.fill_level_nrrp(fill, law(fill), np.array([3.0, 5.0])).tolist() == [1.0, 0.0]  # 2.8, -3.4
+    assert np.allclose(baselines.fill_level_nrrp(fill, law(fill), new), law(new), atol=1e-12)
+    assert baselines.fill_level_nrrp(fill, law(fill), np.array([3.0, 5.0])).tolist() == [1.0, 0.0]  # 2.8, -3.4
 
 
 def test_species_gauge_recovers_a_two_species_count_and_stays_in_0_1():
@@ -105,17 +106,17 @@ def test_species_gauge_recovers_a_two_species_count_and_stays_in_0_1():
     case = lambda w, n=40: (rng.uniform(0, 1, (n, 2)), w)  # noqa: E731
     law = lambda fill, w: w * f(fill[:, 0]) + (1 - w) * g(fill[:, 1])  # noqa: E731
     train = [case(w) for w in (0.3, 0.6, 0.9)]
-    design = np.concatenate([images.species_design(fill, w) for fill, w in train])
+    design = np.concatenate([baselines.species_design(fill, w) for fill, w in train])
     counts = np.concatenate([law(fill, w) for fill, w in train])
     new, w = case(0.75)
-    assert np.allclose(images.species_gauge_nrrp(design, counts, images.species_design(new, w)), law(new, w), atol=1e-12)
-    assert images.species_gauge_nrrp(design, counts, images.species_design(np.array([[3.0, 3.0]]), w)).tolist() == [1.0]
+    assert np.allclose(baselines.species_gauge_nrrp(design, counts, baselines.species_design(new, w)), law(new, w), atol=1e-12)
+    assert baselines.species_gauge_nrrp(design, counts, baselines.species_design(np.array([[3.0, 3.0]]), w)).tolist() == [1.0]
 
 
 def test_fines_count_share_of_a_table1_case():
     # B1-2: 7,596 spheres of 3 and 9 mm, fine volume fraction 0.4 -> a coarse sphere holds 27 fine
     # volumes, so fines are 0.4 x 27 / (0.4 x 27 + 0.6) = 0.947 of the count
-    assert images.fines_count_share("B1-2") == pytest.approx(0.4 * 27 / (0.4 * 27 + 0.6), abs=1 / 7596)
+    assert baselines.fines_count_share("B1-2") == pytest.approx(0.4 * 27 / (0.4 * 27 + 0.6), abs=1 / 7596)
 
 
 def test_species_frames_are_one_grey_frame_per_species():
@@ -124,11 +125,11 @@ def test_species_frames_are_one_grey_frame_per_species():
     frame[0, :4] = 100
     frame[0, 4:6] = 45
     frame[0, 6:, :4] = 40
-    x = images.species_frames(frame, 8)
+    x = frame_data.species_frames(frame, 8)
     assert x.shape == (1, 2, 8, 8) and x.dtype == np.float32
     assert x[0, 0, :4].max() == 0.0 and x[0, 0, 4:].min() == 1.0   # fine channel: dark where fines are
     assert x[0, 1, 4:6].max() == 0.0 and x[0, 1, 6:].min() == 1.0 and x[0, 1, :4].min() == 1.0
-    assert images.species_frames(frame, 2)[0, 0].tolist() == [[0.0, 0.0], [1.0, 1.0]]  # area-averaged
+    assert frame_data.species_frames(frame, 2)[0, 0].tolist() == [[0.0, 0.0], [1.0, 1.0]]  # area-averaged
 
 
 def test_beverloo_baseline_recovers_its_law():
@@ -137,16 +138,16 @@ def test_beverloo_baseline_recovers_its_law():
     attrs = {c: {"case": c} for c in TABLE1}
     truth = {}
     for c, a in attrs.items():
-        m, d, rho = images.case_mass_and_size(a)
+        m, d, rho = baselines.case_mass_and_size(a)
         truth[c] = m / (c_true * rho * math.sqrt(9.81) * 0.04 * (0.054 - k_true * d) ** 1.5)
-    c, k, predict = images.beverloo_discharge({c: truth[c] for c in list(TABLE1)[:15]}, attrs)
+    c, k, predict = baselines.beverloo_discharge({c: truth[c] for c in list(TABLE1)[:15]}, attrs)
     assert c == pytest.approx(c_true, rel=1e-2) and k == pytest.approx(k_true, abs=0.011)  # k on a 0.01 grid
     assert all(predict(attrs[c]) == pytest.approx(truth[c], rel=0.02) for c in list(TABLE1)[15:])
 
 
 def test_windows_for_the_sequence_model():
     x = np.arange(6, dtype=np.float32).reshape(6, 1, 1, 1)
-    w, y = images.windows(x, np.arange(6.0), 4)
+    w, y = training.windows(x, np.arange(6.0), 4)
     assert w.shape == (3, 4, 1, 1, 1) and y.tolist() == [[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]]
 
 
@@ -156,18 +157,18 @@ def test_a_time_budget_stops_training_after_the_epoch_that_spends_it_and_a_rerun
     xv, yv = blobs(8, seed=1)
     ck = tmp_path / "fc.pt"
     torch.manual_seed(0)
-    short = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck, time_budget=0.0)
+    short = training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck, time_budget=0.0)
     assert [e["epoch"] for e in short["history"]] == [1]
     torch.manual_seed(0)
-    rest = images.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck)
+    rest = training.fit(cnn.AlexNetFC(), x, y, xv, yv, epochs=4, batch=16, seed=2, checkpoint=ck)
     assert [e["epoch"] for e in rest["history"]] == [1, 2, 3, 4]
 
 
 def test_the_device_is_the_gpu_only_when_there_is_one():
-    assert images.pick_device("cpu").type == "cpu"
-    assert images.pick_device("auto").type == ("cuda" if torch.cuda.is_available() else "cpu")
+    assert training.pick_device("cpu").type == "cpu"
+    assert training.pick_device("auto").type == ("cuda" if torch.cuda.is_available() else "cpu")
     with pytest.raises(ValueError, match="device"):
-        images.pick_device("tpu")
+        training.pick_device("tpu")
     if not torch.cuda.is_available():
         with pytest.raises(ValueError, match="no GPU"):
-            images.pick_device("cuda")
+            training.pick_device("cuda")

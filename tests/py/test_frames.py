@@ -4,7 +4,8 @@ keeps labels with frames and writes a case whole (a half-written case is not lis
 import numpy as np
 import pytest
 
-from pydem.frames import FrameStore, crop_grey, species_masks
+from pydem.rigs.frames import crop_grey
+from pydem.seed001.store import FrameStore, species_masks
 
 
 def test_crop_is_centred_and_grey_is_bt601():
@@ -72,7 +73,7 @@ def test_store_round_trip_and_whole_cases(tmp_path):
 def test_a_hopper_run_fills_the_store_and_the_gra_reads_it(tmp_path):
     """The tiny hopper with in-memory frames, stored as a case; the seed-001 GRA over stored
     discharge times (weights sum to 100 %, one row per Table 1 parameter)."""
-    from nn.seed001 import PARAMETERS, gra_tables
+    from pydem.seed001.gra import PARAMETERS, gra_tables
     from pydem.rigs import RIGS, load
     cls, cfg_cls = RIGS["hopper"]
     res = cls(load(cfg_cls, "tiny", None, ["frame_interval=0.05", "num_threads=1"])).run(seed=1, images=True)

@@ -1,9 +1,9 @@
-"""Grey relational analysis (nn/gra.py) against a hand-worked 2-parameter, 3-case table, and its
+"""Grey relational analysis (pydem/seed001/gra.py) against a hand-worked 2-parameter, 3-case table, and its
 limits: a parameter that follows the response exactly has every coefficient 1."""
 import numpy as np
 import pytest
 
-from nn.gra import grey_relational
+from pydem.seed001.gra import grey_relational
 
 
 def test_hand_worked_table():

@@ -14,7 +14,7 @@ SUBSET = ROOT / "data/seed001/frames_subset.h5"
 
 
 def test_the_subset_holds_every_case_with_consistent_labels():
-    from pydem.frames import FrameStore
+    from pydem.seed001.store import FrameStore
     from pydem.rigs.hopper import TABLE1
     store = FrameStore(SUBSET)
     assert store.cases() == sorted(TABLE1)
@@ -27,8 +27,8 @@ def test_the_subset_holds_every_case_with_consistent_labels():
 
 
 def test_gra_weights_are_percentages_over_the_cases():
-    from pydem.frames import FrameStore
-    from nn.seed001 import PARAMETERS, gra_tables
+    from pydem.seed001.store import FrameStore
+    from pydem.seed001.gra import PARAMETERS, gra_tables
     store = FrameStore(SUBSET)
     tables = gra_tables({c: float(store.read_case(c)["discharge_time"]) for c in store.cases()})
     assert set(tables) == {"A", "B1", "B2", "B3", "B4", "all"}
@@ -37,7 +37,7 @@ def test_gra_weights_are_percentages_over_the_cases():
 
 
 def test_pydem_images_is_the_seed001_command_line():
-    """`pydem images ...` hands its arguments to nn.seed001 whole (its own --help included)."""
+    """`pydem images ...` hands its arguments to pydem.seed001.cli whole (its own --help included)."""
     import subprocess
     import sys
     run = lambda *a: subprocess.run([sys.executable, "-m", "pydem", "images", *a], capture_output=True, text=True,
@@ -50,8 +50,8 @@ def test_pydem_images_is_the_seed001_command_line():
 
 def test_experiments_and_report_run_on_the_subset(tmp_path):
     import torch
-    from nn import seed001_experiments as ex
-    from nn.seed001_report import write
+    from pydem.seed001 import experiments as ex
+    from pydem.seed001.report import write
     torch.set_num_threads(1)
     p2p = ex.point_to_point(SUBSET, tmp_path, size=64, every=2, epochs=1, say=lambda *a: None)
     assert set(p2p["splits"]) == {"random_frames", "leave_cases_out"}
@@ -78,7 +78,7 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
 
 def test_windows_with_a_stride_start_every_stride_frames():
     import numpy as np
-    from nn.images import windows
+    from nn.training import windows
     x = np.arange(10, dtype=np.float32).reshape(10, 1, 1, 1)
     xw, yw = windows(x, np.arange(10.0), 4, stride=3)
     assert xw.shape == (3, 4, 1, 1, 1) and yw[:, 0].tolist() == [0.0, 3.0, 6.0] and yw[-1].tolist() == [6, 7, 8, 9]
@@ -87,7 +87,7 @@ def test_windows_with_a_stride_start_every_stride_frames():
 def test_fit_keeps_a_given_target_scaling():
     import numpy as np
     import torch
-    from nn.images import fit
+    from nn.training import fit
     torch.manual_seed(0)
     model = torch.nn.Linear(1, 1)
     x = np.linspace(0, 1, 16, dtype=np.float32).reshape(-1, 1)
@@ -101,7 +101,7 @@ def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
     import subprocess
     import sys
     code = ("import sys; sys.path.insert(0, 'bench'); import seed001_device as d; d.import_without_binding(); "
-            "import pydem.frames, pydem.rigs.table1, nn.images; "
+            "import pydem.seed001.cli, pydem.seed001.store, pydem.rigs.table1, nn.training; "
             "assert 'pydem._libdem' not in sys.modules; print(len(pydem.rigs.table1.TABLE1))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
                          env={**os.environ, "SEED001_NO_BINDING": "1"})

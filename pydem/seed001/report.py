@@ -1,15 +1,19 @@
 """The seed 001 report: the grey relational analysis, the four-CNN comparison (Table 2), AlexNet-FC
 point to point on both splits, the CNN-LSTM process prediction per packing pattern, each beside
 its physics baseline and the seed's own numbers, and the CPU-time accounting; report.html
-(self-contained) and report.md with the plots as PNG files (pydem's report writer).
+(self-contained) and report.md with the plots as PNG files (pydem.report_page).
 
-    .venv/bin/python -m nn.seed001 report --store STORE --results DIR --out DIR"""
+    .venv/bin/python -m pydem.seed001 report --store STORE --results DIR --out DIR"""
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
 import numpy as np
+
+from .. import report_page as page
+from .gra import PARAMETERS, gra_tables
+from .store import FrameStore
 
 # seed 001's own figures (its Table 2, Fig. 3c, Fig. 6 and Section 4)
 SEED_TABLE2 = {"alexnet": (46.617, 61.286, 0.997), "resnet50": (358.937, 513.528, 0.714),
@@ -28,9 +32,6 @@ def _f(v, fmt=".3g") -> str:
 
 
 def gra_section(store, plots: dict):
-    from pydem.calibration.report import _png, _table
-    from pydem.frames import FrameStore
-    from .seed001 import PARAMETERS, gra_tables
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -38,7 +39,7 @@ def gra_section(store, plots: dict):
     discharge = {c: float(s.read_case(c)["discharge_time"]) for c in s.cases()}
     tables = gra_tables(discharge)
     rows = [[p] + [_f(t[p], ".2f") for t in tables.values()] + [_f(SEED_GRA.get(p), ".2f")] for p in PARAMETERS]
-    md, h = _table(rows, ["parameter (weight %)"] + list(tables) + ["seed 001, mean"])
+    md, h = page.table(rows, ["parameter (weight %)"] + list(tables) + ["seed 001, mean"])
     fig, ax = plt.subplots(figsize=(9, 3.6))
     width = 0.8 / max(len(tables), 1)
     for i, (name, t) in enumerate(tables.items()):
@@ -47,7 +48,7 @@ def gra_section(store, plots: dict):
     ax.set_ylabel("GRA weight (%)")
     ax.set_ylim(min(min(t.values()) for t in tables.values()) - 0.5, max(max(t.values()) for t in tables.values()) + 0.5)
     ax.legend(ncol=6, fontsize=8)
-    plots["gra.png"] = _png(fig)
+    plots["gra.png"] = page.png(fig)
     top = max(tables["all"], key=tables["all"].get) if "all" in tables else None
     low = min(tables["all"], key=tables["all"].get) if "all" in tables else None
     line = (f"Over {len(discharge)} cases: highest {top} ({tables['all'][top]:.2f} %), lowest {low} "
@@ -56,7 +57,6 @@ def gra_section(store, plots: dict):
 
 
 def compare_section(res: dict):
-    from pydem.calibration.report import _table
     rows = []
     for name, r in res["models"].items():
         seed = SEED_TABLE2.get(name, (None,) * 3)
@@ -65,7 +65,7 @@ def compare_section(res: dict):
                      _f(r["predict_ms_per_frame"])])
     b = res["baseline"]
     rows.append(["Beverloo x fill fraction", _f(1e3 * b["mae"]), _f(1e3 * b["rmse"]), _f(b["r2"]), "", "", "", "", "", ""])
-    md, h = _table(rows, ["network", "MAE (ms)", "RMSE (ms)", "R^2", "seed MAE", "seed RMSE", "seed R^2", "epochs",
+    md, h = page.table(rows, ["network", "MAE (ms)", "RMSE (ms)", "R^2", "seed MAE", "seed RMSE", "seed R^2", "epochs",
                           "train s", "predict ms/frame"])
     st = res["settings"]
     budget = f" or {st['time_budget_s']:.0f} s of training, whichever came first" if "time_budget_s" in st else ""
@@ -75,7 +75,6 @@ def compare_section(res: dict):
 
 
 def point_to_point_section(res: dict, plots: dict):
-    from pydem.calibration.report import _png, _table
     import matplotlib.pyplot as plt
     rows = []
     for split, r in res["splits"].items():
@@ -84,7 +83,7 @@ def point_to_point_section(res: dict, plots: dict):
         for pk, p in r["per_packing"].items():
             rows.append([split, pk, _f(p["net"]["r2"]), _f(p["net"]["relative_error"]), _f(p["baseline"]["r2"]),
                          _f(p["baseline"]["relative_error"])])
-    md, h = _table(rows, ["split", "packing", "AlexNet-FC R^2", "relative error", "baseline R^2", "baseline relative error"])
+    md, h = page.table(rows, ["split", "packing", "AlexNet-FC R^2", "relative error", "baseline R^2", "baseline relative error"])
     fig, axes = plt.subplots(1, len(res["splits"]), figsize=(5 * len(res["splits"]), 4.2), squeeze=False)
     for ax, (split, r) in zip(axes[0], res["splits"].items()):
         t = r["test"]
@@ -98,7 +97,7 @@ def point_to_point_section(res: dict, plots: dict):
         ax.set_xlabel("remaining discharge time, DEM (s)")
         ax.set_ylabel("AlexNet-FC (s)")
         ax.legend(fontsize=7, markerscale=3)
-    plots["parity.png"] = _png(fig)
+    plots["parity.png"] = page.png(fig)
     st = res["settings"]
     line = (f"{st['frames']} frames at {st['size']} x {st['size']}, {st['epochs']} epochs; leave-cases-out tests on "
             f"{', '.join(st['test_cases'])} (validation {', '.join(st['validation_cases'])}). Seed 001: {SEED_FC}.")
@@ -106,14 +105,13 @@ def point_to_point_section(res: dict, plots: dict):
 
 
 def process_section(res: dict, plots: dict):
-    from pydem.calibration.report import _png, _table
     import matplotlib.pyplot as plt
     zero = any("zero_shot" in v for v in res["per_packing"].values())
     # the gauges each run has (older runs lack one or both)
     gauges = [g for g in ("fill_level", "species") if all(g in v for v in res["per_packing"].values())]
     rows = [[pk, _f(v["net"])] + ([_f(v["zero_shot"])] if zero else []) + [_f(v["baseline"])]
             + [_f(v[g]) for g in gauges] for pk, v in res["per_packing"].items()]
-    md, h = _table(rows, ["packing", "CNN-LSTM relative error"] + (["zero-shot (no frame of the case)"] if zero else [])
+    md, h = page.table(rows, ["packing", "CNN-LSTM relative error"] + (["zero-shot (no frame of the case)"] if zero else [])
                    + ["constant-rate relative error"] + [f"{g.replace('_', '-')} gauge relative error" for g in gauges])
     fig, axes = plt.subplots(1, 5, figsize=(13, 2.8), sharey=True)
     for ax, pk in zip(axes, ("A", "B1", "B2", "B3", "B4")):
@@ -131,7 +129,7 @@ def process_section(res: dict, plots: dict):
         ax.set_xlabel("t (s)")
     axes[0].set_ylabel("NRRP")
     axes[0].legend(fontsize=7)
-    plots["nrrp.png"] = _png(fig)
+    plots["nrrp.png"] = page.png(fig)
     st = res["settings"]
     if st.get("protocol", "per-case") == "pretrained":
         how = (f"Pretrained on other cases' whole discharges (leave-fold-out, {st['epochs']} epochs), fine-tuned on "
@@ -144,7 +142,6 @@ def process_section(res: dict, plots: dict):
 
 
 def write(store, results, out) -> Path:
-    from pydem.calibration.report import write_page
     results, out = Path(results), Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plots: dict[str, bytes] = {}
@@ -158,4 +155,4 @@ def write(store, results, out) -> Path:
             sections.append(build(r))
     for name, png in plots.items():
         (out / name).write_bytes(png)
-    return write_page(out, "Seed 001: hopper images", sections, plots, head=len(sections))
+    return page.write_page(out, "Seed 001: hopper images", sections, plots, head=len(sections))

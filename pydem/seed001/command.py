@@ -1,6 +1,6 @@
 """`pydem images`: seed 001's image half on a hopper frame store — the Table 1 frame set, grey
 relational analysis, the four CNNs compared, AlexNet-FC, the CNN-LSTM and the report
-(nn/seed001.py; needs torch, the `[nn]` extra).
+(pydem/seed001/cli.py; the networks need torch, the `[nn]` extra).
 
     pydem images gra --store data/seed001/frames_subset.h5
     pydem images point-to-point --store data/seed001/frames_subset.h5 --out /tmp/p2p --epochs 2
@@ -19,10 +19,10 @@ def add_parser(sub):
 
 
 def forward(argv: list[str]) -> int:
-    """Runs nn.seed001's command line on argv (pydem's own parser would take `--help` and the like
+    """Runs pydem.seed001's command line on argv (pydem's own parser would take `--help` and the like
     for itself, so pydem.cli hands `images ...` over before parsing)."""
     try:
-        from nn.seed001 import main as seed001
+        from .cli import main as seed001
     except ImportError as exc:
         print(f"pydem images: the image networks need torch (pip install 'pydem[nn]'): {exc}", file=sys.stderr)
         return 2

@@ -1,15 +1,15 @@
 """Seed 001's data and its grey relational analysis: the 25 Table 1 hopper cases run at their
 full particle counts, every frame centre-cropped and greyed into one HDF5 frame store
-(pydem.frames), each labelled with its time, remaining discharge time and NRRP; then the GRA of
-the 11 Table 1 parameters against the cases' discharge times (nn.gra), per packing and overall.
+(pydem.seed001.store), each labelled with its time, remaining discharge time and NRRP; then the GRA of
+the 11 Table 1 parameters against the cases' discharge times (pydem.seed001.gra), per packing and overall.
 
-    .venv/bin/python -m nn.seed001 frames --store data/seed001/frames.h5 [--cases A-1 B1-3] [--frame-interval 0.02]
-    .venv/bin/python -m nn.seed001 gra --store data/seed001/frames.h5
-    .venv/bin/python -m nn.seed001 subset --store data/seed001/frames_full.h5 --out data/seed001/frames_subset.h5 --every 25
-    .venv/bin/python -m nn.seed001 compare|point-to-point|process --store STORE --out DIR [--size 64 --epochs N]
-    .venv/bin/python -m nn.seed001 report --store STORE --results DIR --out DIR
+    .venv/bin/python -m pydem.seed001 frames --store data/seed001/frames.h5 [--cases A-1 B1-3] [--frame-interval 0.02]
+    .venv/bin/python -m pydem.seed001 gra --store data/seed001/frames.h5
+    .venv/bin/python -m pydem.seed001 subset --store data/seed001/frames_full.h5 --out data/seed001/frames_subset.h5 --every 25
+    .venv/bin/python -m pydem.seed001 compare|point-to-point|process --store STORE --out DIR [--size 64 --epochs N]
+    .venv/bin/python -m pydem.seed001 report --store STORE --results DIR --out DIR
 
-The last three are nn.seed001_experiments (the networks beside their physics baselines; results
+The last three are pydem.seed001.experiments (the networks beside their physics baselines; results
 as JSON in DIR). The frame campaign is resumable: a case is written whole when its run ends, and a rerun does
 only the cases the store lacks."""
 from __future__ import annotations
@@ -20,41 +20,12 @@ import time
 
 import numpy as np
 
-from .gra import grey_relational
-
-# the 11 Table 1 parameters, in the seed's order, and how to read each from a TABLE1 row
-PARAMETERS = ("mu_pp", "mu_pw", "e_pp", "e_pw", "mu_r", "density", "diameter", "youngs_modulus", "poisson_ratio",
-              "particles", "fine_fraction")
-
-
-def parameter_row(case: str) -> dict[str, float]:
-    """The case's 11 parameters; the diameter is the volume-weighted mean of its two sizes (the
-    seed lists one d per case: its fine/coarse pair weighted by the fine volume fraction)."""
-    from pydem.rigs.table1 import TABLE1
-    n, nu, e_gpa, phi, epp, ewp, mupp, muwp, mur, dd, rho = TABLE1[case]
-    return {"mu_pp": mupp, "mu_pw": muwp, "e_pp": epp, "e_pw": ewp, "mu_r": mur, "density": float(rho),
-            "diameter": phi * dd[0] + (1.0 - phi) * dd[1], "youngs_modulus": e_gpa * 1e9, "poisson_ratio": nu,
-            "particles": float(n), "fine_fraction": phi}
-
-
-def gra_tables(discharge: dict[str, float], rho: float = 0.5) -> dict[str, dict[str, float]]:
-    """{group: {parameter: weight %}} for each packing (its cases in Table 1 order) and "all"."""
-    from pydem.rigs.table1 import TABLE1
-    groups = {p: [c for c in TABLE1 if c.split("-")[0] == p and c in discharge] for p in ("A", "B1", "B2", "B3", "B4")}
-    groups["all"] = [c for c in TABLE1 if c in discharge]
-    out = {}
-    for name, cases in groups.items():
-        if len(cases) < 2:
-            continue
-        x = np.array([[parameter_row(c)[p] for c in cases] for p in PARAMETERS])
-        _, weights = grey_relational(x, [discharge[c] for c in cases], rho)
-        out[name] = dict(zip(PARAMETERS, map(float, weights)))
-    return out
-
+from ..rigs.table1 import TABLE1
+from .gra import PARAMETERS, gra_tables, parameter_row
+from .store import FrameStore
 
 def run_frames(store_path: str, cases: list[str], frame_interval: float, threads: int, say=print):
-    from pydem.frames import FrameStore
-    from pydem.rigs import RIGS, load
+    from ..rigs import RIGS, load  # the rigs need the compiled binding; the other commands run without it
     store = FrameStore(store_path)
     done = set(store.cases())
     cls, cfg_cls = RIGS["hopper"]
@@ -82,7 +53,6 @@ def run_frames(store_path: str, cases: list[str], frame_interval: float, threads
 
 def write_subset(full: str, out: str, every: int):
     """Every `every`-th frame of each case of `full` into the store `out` (labels and attributes kept)."""
-    from pydem.frames import FrameStore
     src, dst = FrameStore(full), FrameStore(out)
     for case in src.cases():
         d = src.read_case(case)
@@ -91,8 +61,7 @@ def write_subset(full: str, out: str, every: int):
                        attrs | {"subset_every": every})
 
 
-def main(argv=None, prog: str = "python -m nn.seed001") -> int:
-    from pydem.rigs.table1 import TABLE1
+def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
     ap = argparse.ArgumentParser(prog=prog)
     sub = ap.add_subparsers(dest="cmd", required=True)
     f = sub.add_parser("frames", help="run the Table 1 cases into the frame store (resumable)")
@@ -139,7 +108,7 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
     rp.add_argument("--out", required=True)
     args = ap.parse_args(argv)
     if args.cmd == "report":
-        from .seed001_report import write
+        from .report import write
         print(f"written {write(args.store, args.results, args.out)}")
         return 0
     if args.cmd == "frames":
@@ -150,7 +119,7 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         return 0
     if args.cmd in ("compare", "point-to-point", "process"):
         import torch
-        from . import seed001_experiments as ex
+        from . import experiments as ex
         torch.set_num_threads(args.threads)
         if torch.cuda.is_available():
             torch.backends.cudnn.benchmark = True  # fixed input shapes: cuDNN may pick its fastest kernels
@@ -166,7 +135,6 @@ def main(argv=None, prog: str = "python -m nn.seed001") -> int:
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
         run(args.store, args.out, size=args.size, seed=args.seed, **kw)
         return 0
-    from pydem.frames import FrameStore
     store = FrameStore(args.store)
     discharge = {c: float(store.read_case(c)["discharge_time"]) for c in store.cases()}
     if len(discharge) < 2:

@@ -27,13 +27,17 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from . import cnn, images
+from nn import cnn, training
+
+from ..progress import EpochProgress
+from . import baselines, frame_data
+from .store import FrameStore
 
 PACKINGS = ("A", "B1", "B2", "B3", "B4")
 LSTM_CLIP = 1.0  # gradient norm cap of the CNN-LSTM's steps (recurrent layers)
 
 
-def _packing(case: str) -> str:
+def packing_of(case: str) -> str:
     return case.split("-")[0]
 
 
@@ -44,29 +48,28 @@ def _machine(device: torch.device | None = None) -> str:
             f"{torch.get_num_threads()} threads{where}")
 
 
-def _beverloo_per_frame(f: images.Frames, train_cases, first_frames: dict) -> tuple[np.ndarray, dict]:
+def _beverloo_per_frame(f: frame_data.Frames, train_cases, first_frames: dict) -> tuple[np.ndarray, dict]:
     """Remaining discharge time per frame: fill fraction x Beverloo discharge time of its case."""
-    c, k, t_dis = images.beverloo_discharge({cs: f.discharge[cs] for cs in train_cases}, f.attrs)
+    c, k, t_dis = baselines.beverloo_discharge({cs: f.discharge[cs] for cs in train_cases}, f.attrs)
     pred = np.empty(len(f.x))
     for cs in np.unique(f.case):
         m = f.case == cs
-        pred[m] = images.fill_fraction(f.x[m], first_frames[cs]) * t_dis(f.attrs[cs])
+        pred[m] = baselines.fill_fraction(f.x[m], first_frames[cs]) * t_dis(f.attrs[cs])
     return pred, {"C": c, "k": k}
 
 
 def _first_frames(store, size: int) -> dict:
-    from pydem.frames import FrameStore
     s = FrameStore(store)
-    return {c: images.shrink(s.read_case(c)["frames"][:1], size)[0] for c in s.cases()}
+    return {c: frame_data.shrink(s.read_case(c)["frames"][:1], size)[0] for c in s.cases()}
 
 
-def _train(name: str, build, f: images.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say,
+def _train(name: str, build, f: frame_data.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say,
            device: torch.device = torch.device("cpu"), time_budget: float | None = None):
     torch.manual_seed(seed)
     model = build().to(device)
     t0 = time.perf_counter()
-    scaling = images.fit(model, f.x[tr], f.remaining[tr], f.x[va], f.remaining[va], epochs=epochs, batch=batch, lr=lr,
-                         seed=seed, checkpoint=out / f"{name}.pt", progress=images.Progress(say), time_budget=time_budget)
+    scaling = training.fit(model, f.x[tr], f.remaining[tr], f.x[va], f.remaining[va], epochs=epochs, batch=batch, lr=lr,
+                         seed=seed, checkpoint=out / f"{name}.pt", progress=EpochProgress(say), time_budget=time_budget)
     seconds = time.perf_counter() - t0
     return model, scaling, seconds
 
@@ -81,9 +84,9 @@ def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: 
     if unknown:
         raise ValueError(f"networks {unknown}: not among {sorted(cnn.BACKBONES)}")
     out = Path(out)
-    dev = images.pick_device(device)
-    f = images.load_frames(store, size=size, every=every)
-    tr, va, te = images.random_split(len(f.x), seed)
+    dev = training.pick_device(device)
+    f = frame_data.load_frames(store, size=size, every=every)
+    tr, va, te = frame_data.random_split(len(f.x), seed)
     say(f"compare: {len(f.x)} frames of {len(f.discharge)} cases at {size} x {size}; train {len(tr)}, validation {len(va)}, "
         f"test {len(te)}; on {dev}")
     res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
@@ -95,15 +98,15 @@ def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: 
         model, scaling, seconds = _train(name, cnn.BACKBONES[name], f, tr, va, epochs, batch, lr, seed,
                                          Path(checkpoints or out), say, dev, time_budget)
         t0 = time.perf_counter()
-        pred = images.predict(model, f.x[te], scaling)
+        pred = training.predict(model, f.x[te], scaling)
         per_frame = (time.perf_counter() - t0) / max(len(te), 1)
-        res["models"][name] = images.scores(f.remaining[te], pred) | {
+        res["models"][name] = frame_data.scores(f.remaining[te], pred) | {
             "train_seconds": seconds, "epochs_run": len(scaling["history"]),
             "predict_ms_per_frame": 1e3 * per_frame, "parameters": cnn.parameter_count(model)}
         say(f"  {name}: " + ", ".join(f"{k} {v:.4g}" for k, v in res["models"][name].items()))
         _save(out / "compare.json", res)  # each network's row is kept as soon as it exists
     base, law = _beverloo_per_frame(f, sorted(f.discharge), _first_frames(store, size))
-    res["baseline"] = images.scores(f.remaining[te], base[te]) | {"law": law}
+    res["baseline"] = frame_data.scores(f.remaining[te], base[te]) | {"law": law}
     _save(out / "compare.json", res)
     return res
 
@@ -111,8 +114,8 @@ def compare(store, out, size: int = 64, every: int = 4, epochs: int = 8, batch: 
 def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12, batch: int = 32, lr: float = 1e-4,
                    seed: int = 0, device: str = "auto", checkpoints=None, say=print) -> dict:
     out = Path(out)
-    dev = images.pick_device(device)
-    f = images.load_frames(store, size=size, every=every)
+    dev = training.pick_device(device)
+    f = frame_data.load_frames(store, size=size, every=every)
     cases = sorted(f.discharge)
     test_cases = [c for c in cases if c.endswith("-5")]       # one case of every packing
     val_cases = [c for c in cases if c.endswith("-4")]
@@ -121,26 +124,26 @@ def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12,
                         "frames": int(len(f.x)), "test_cases": test_cases, "validation_cases": val_cases,
                         "device": str(dev)},
            "machine": _machine(dev), "splits": {}}
-    for split, (tr, va, te) in (("random_frames", images.random_split(len(f.x), seed)),
-                                ("leave_cases_out", images.case_split(f.case, test_cases, val_cases))):
+    for split, (tr, va, te) in (("random_frames", frame_data.random_split(len(f.x), seed)),
+                                ("leave_cases_out", frame_data.case_split(f.case, test_cases, val_cases))):
         say(f"- AlexNet-FC, {split}: train {len(tr)}, validation {len(va)}, test {len(te)} frames")
         if not (len(tr) and len(va) and len(te)):
             say("  an empty part (leave-cases-out holds out the -5 cases and validates on the -4 cases): skipped")
             continue
         model, scaling, seconds = _train(f"alexnet_fc_{split}", cnn.AlexNetFC, f, tr, va, epochs, batch, lr, seed,
                                          Path(checkpoints or out), say, dev)
-        pred = images.predict(model, f.x[te], scaling)
+        pred = training.predict(model, f.x[te], scaling)
         train_cases = sorted(set(f.case[tr]))
         base, law = _beverloo_per_frame(f, train_cases, first)
-        row = {"all": images.scores(f.remaining[te], pred), "baseline_all": images.scores(f.remaining[te], base[te]),
+        row = {"all": frame_data.scores(f.remaining[te], pred), "baseline_all": frame_data.scores(f.remaining[te], base[te]),
                "train_seconds": seconds, "law": law, "per_packing": {},
                "test": {"case": f.case[te].tolist(), "remaining": f.remaining[te].tolist(), "predicted": pred.tolist(),
                         "baseline": base[te].tolist()}}
         for pk in PACKINGS:
-            m = np.array([_packing(c) == pk for c in f.case[te]])
+            m = np.array([packing_of(c) == pk for c in f.case[te]])
             if m.sum() > 1:
-                row["per_packing"][pk] = {"net": images.scores(f.remaining[te][m], pred[m]),
-                                          "baseline": images.scores(f.remaining[te][m], base[te][m])}
+                row["per_packing"][pk] = {"net": frame_data.scores(f.remaining[te][m], pred[m]),
+                                          "baseline": frame_data.scores(f.remaining[te][m], base[te][m])}
         res["splits"][split] = row
         say(f"  R^2 {row['all']['r2']:.3f}, relative error {row['all']['relative_error']:.3f} "
             f"(baseline {row['baseline_all']['r2']:.3f}, {row['baseline_all']['relative_error']:.3f})")
@@ -148,23 +151,23 @@ def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12,
     return res
 
 
-def _fold(case: str) -> str:
+def fold_of(case: str) -> str:
     """A case's fold for leave-cases-out: its index within its packing (A-3 -> "3")."""
     return case.rsplit("-", 1)[1]
 
 
-def _nrrp_windows(f: images.Frames, window: int, stride: int = 1):
-    return images.windows(f.x, f.nrrp.astype(np.float32), window, stride)
+def _nrrp_windows(f: frame_data.Frames, window: int, stride: int = 1):
+    return training.windows(f.x, f.nrrp.astype(np.float32), window, stride)
 
 
-def _read_later(model, f: images.Frames, k: int, window: int, scaling: dict) -> np.ndarray:
+def _read_later(model, f: frame_data.Frames, k: int, window: int, scaling: dict) -> np.ndarray:
     """The NRRP of every frame from k on, read from the window of `window` frames ending there."""
-    xr, _ = images.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
-    return np.clip(images.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
+    xr, _ = training.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
+    return np.clip(training.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
 
 
 def _window_mse(model, xw, yw, scaling: dict) -> float:
-    return float(np.mean((images.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
+    return float(np.mean((training.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
 
 
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
@@ -181,21 +184,20 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     `finetune_epochs`), the fine-tuned weights kept only where they lower the error on the
     case's own held-back early windows. The zero-shot prediction (no frame of the case seen) is
     reported beside it. In both, each later frame's NRRP is read from the window ending at it.
-    `inputs`: what the network sees of a frame (images.INPUTS): the grey frame, seed 001's, or
+    `inputs`: what the network sees of a frame (frame_data.INPUTS): the grey frame, seed 001's, or
     its two species (fine, coarse) as separate channels."""
-    from pydem.frames import FrameStore
     if protocol not in ("pretrained", "per-case"):
         raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
     epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
-    dev = images.pick_device(device)
+    dev = training.pick_device(device)
     res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
                         "protocol": protocol, "inputs": inputs, "gradient_clip": LSTM_CLIP, "device": str(dev)} | ({"stride": stride, "finetune_epochs": finetune_epochs,
                                                   "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
            "machine": _machine(dev), "cases": {}}
     cases = FrameStore(store).cases()
-    data = {c: images.load_frames(store, cases=[c], size=size, inputs=inputs) for c in cases}
-    folds = sorted({_fold(c) for c in cases})
+    data = {c: frame_data.load_frames(store, cases=[c], size=size, inputs=inputs) for c in cases}
+    folds = sorted({fold_of(c) for c in cases})
     pretrained, gauges = {}, {}
     if protocol == "pretrained":
         if len(folds) < 3:
@@ -204,8 +206,8 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         gauges = gauge_inputs(store, cases, size)
         for fold in folds:
             val_fold = validation_fold(fold, folds)
-            tr = [w for c, w in whole.items() if _fold(c) in pretraining_folds(fold, folds)]
-            va = [w for c, w in whole.items() if _fold(c) == val_fold]
+            tr = [w for c, w in whole.items() if fold_of(c) in pretraining_folds(fold, folds)]
+            va = [w for c, w in whole.items() if fold_of(c) == val_fold]
             xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
             xv, yv = np.concatenate([a for a, _ in va]), np.concatenate([b for _, b in va])
             say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
@@ -213,8 +215,8 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
             torch.manual_seed(seed)
             model = cnn.CNNLSTM(in_channels=xt.shape[2]).to(dev)
             t0 = time.perf_counter()
-            scaling = images.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
-                                 checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=images.Progress(say))
+            scaling = training.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
+                                 checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=EpochProgress(say))
             pretrained[fold] = (model, scaling, time.perf_counter() - t0)
     for case in cases:
         f = data[case]
@@ -229,13 +231,13 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         if protocol == "per-case":
             torch.manual_seed(seed)
             model = cnn.CNNLSTM(in_channels=f.x.shape[1]).to(dev)
-            scaling = images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
+            scaling = training.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
                                  lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
         else:
-            base_model, scaling, pre_seconds = pretrained[_fold(case)]
-            row["zero_shot"] = images.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
+            base_model, scaling, pre_seconds = pretrained[fold_of(case)]
+            row["zero_shot"] = frame_data.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
             model = copy.deepcopy(base_model)
-            images.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
+            training.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
                        lr=lr / 10, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_finetune_{case}.pt",
                        scaling=scaling)
             before, after = (_window_mse(m, xw[-n_val:], yw[-n_val:], scaling) for m in (base_model, model))
@@ -246,8 +248,8 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         row["train_seconds"] = time.perf_counter() - t0
         pred = _read_later(model, f, k, window, scaling)
         truth = f.nrrp[k:]
-        base = images.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
-        row |= {"net": images.scores(truth, pred), "baseline": images.scores(truth, base), "time": f.time[k:].tolist(),
+        base = baselines.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
+        row |= {"net": frame_data.scores(truth, pred), "baseline": frame_data.scores(truth, base), "time": f.time[k:].tolist(),
                 "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": base.tolist()}
         if protocol == "pretrained":
             row |= gauge_rows(case, gauges, data, folds, k)
@@ -259,8 +261,8 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     keys = ("net", "baseline") + (("zero_shot",) + GAUGES if protocol == "pretrained" else ())
     res["per_packing"] = {pk: {key: float(np.mean(errs)) for key in keys
                                if (errs := [r[key]["relative_error"] for c, r in res["cases"].items()
-                                            if _packing(c) == pk and key in r])}
-                          for pk in PACKINGS if any(_packing(c) == pk for c in res["cases"])}
+                                            if packing_of(c) == pk and key in r])}
+                          for pk in PACKINGS if any(packing_of(c) == pk for c in res["cases"])}
     _save(out / "process.json", res)
     return res
 
@@ -287,16 +289,15 @@ SPECIES_DEGREE = 2
 
 def gauge_inputs(store, cases, size: int, rows: dict | None = None) -> dict:
     """What the image gauges read of each case's frames: its grey fill fraction at the network's
-    frame size (images.fill_fraction) and the fill of each species (images.species_fill, from
+    frame size (baselines.fill_fraction) and the fill of each species (baselines.species_fill, from
     the stored 224 x 224 frames), with the fines' share of its count (from Table 1, or from
     rows[case], a Table 1-style row, for a hopper not in it)."""
-    from pydem.frames import FrameStore
     st, out = FrameStore(store), {}
     for c in cases:
         raw = st.read_case(c)["frames"]
-        grey = images.shrink(raw, size)
-        out[c] = {"fill": images.fill_fraction(grey, grey[0]), "species": images.species_fill(raw),
-                  "fines_share": images.fines_count_share(c, (rows or {}).get(c))}
+        grey = frame_data.shrink(raw, size)
+        out[c] = {"fill": baselines.fill_fraction(grey, grey[0]), "species": baselines.species_fill(raw),
+                  "fines_share": baselines.fines_count_share(c, (rows or {}).get(c))}
     return out
 
 
@@ -304,23 +305,23 @@ def gauge_rows(case: str, gauges: dict, data: dict, folds: list[str], k: int) ->
     """The case's NRRP from frame k on as two image gauges read it, each calibrated on the whole
     discharges of cases its network pretrains on — the same cases, the same frames, no learning
     beyond least squares, per packing: `fill_level`, a cubic of the grey fill fraction
-    (images.fill_level_nrrp); `species`, the count from each species' fill, quadratic in each
-    (images.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
+    (baselines.fill_level_nrrp); `species`, the count from each species' fill, quadratic in each
+    (baselines.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
     per packing erred least on the 1 ms frame set, 2026-11-28). Their scores and readings."""
-    same = [c for c in gauges if _packing(c) == _packing(case) and _fold(c) in pretraining_folds(_fold(case), folds)]
+    same = [c for c in gauges if packing_of(c) == packing_of(case) and fold_of(c) in pretraining_folds(fold_of(case), folds)]
     row = gauge_readings(case, same, gauges, {c: data[c].nrrp for c in same + [case]}, k) if same else {}
     truth = data[case].nrrp[k:]
-    return {name: images.scores(truth, v) for name, v in row.items()} | {f"{name}_nrrp": v.tolist() for name, v in row.items()}
+    return {name: frame_data.scores(truth, v) for name, v in row.items()} | {f"{name}_nrrp": v.tolist() for name, v in row.items()}
 
 
 def gauge_readings(case: str, train: list[str], gauges: dict, nrrp: dict, k: int) -> dict:
     """{gauge: the case's NRRP from frame k on} with both gauges calibrated on `train`'s whole
     discharges (gauges: gauge_inputs; nrrp: each training case's NRRP series)."""
-    design = lambda c: images.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
+    design = lambda c: baselines.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
     y = np.concatenate([nrrp[c] for c in train])
-    return {"fill_level": images.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in train]), y,
+    return {"fill_level": baselines.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in train]), y,
                                                  gauges[case]["fill"][k:]),
-            "species": images.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])}
+            "species": baselines.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])}
 
 
 def _save(path: Path, res: dict):
