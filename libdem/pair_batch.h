@@ -29,7 +29,7 @@ typedef struct pair_batch_scratch {
 /* The arrays first, each a multiple of 64 bytes: every double array starts on a cache line
  * when the batch does, so fewer vector loads of the stage loops straddle two lines (with the
  * counts and flags first, the arrays sat at 8 mod 16 bytes: part of a 3-4 % loss on the
- * packed bed, bench/README.md). */
+ * packed bed, studies/JOURNAL.md). */
 typedef struct pair_batch {
     /* gathered: list entry, partner, geometry and kinematics (i minus j). A batch of wall
      * contacts (dem_wall_batch_law) instead holds in dx, dy, dz the unit normal (towards the

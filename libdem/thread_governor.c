@@ -1,6 +1,6 @@
 /* The thread governor: on a shared machine a thread of the team can be descheduled, and every
  * step's barriers then wait for it — a 2-thread run beside one busy process ran 3-9x slower than
- * on 1 thread (bench/README.md, "A busy machine"); and a small system (a few thousand spheres)
+ * on 1 thread (studies/JOURNAL.md, "A busy machine"); and a small system (a few thousand spheres)
  * can run slower on more threads when the barriers sleep. So the step loop measures its sweeps
  * and now and then tries a neighbouring team size (half or double the current one, within 1 ...
  * num_threads) for one short window, keeping it when it is clearly faster. A probe that loses

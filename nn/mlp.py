@@ -6,7 +6,7 @@ Patience: 100 validation failures, not MATLAB trainscg's 6. A campaign holds ~10
 validation split is ~14 noisy points and its loss rises for a few epochs again and again while
 the fit is still improving; after 6 failures SCG stopped at 10-30 epochs and the ring-shear nets
 held out R^2 ~0.75 where a Gaussian process on the same runs reaches 0.94 (patience 100: 0.94;
-bench/surrogate_training.py, docs/surrogates.md). The best-validation weights are restored, so
+studies/surrogate_training.py, docs/surrogates.md). The best-validation weights are restored, so
 patience costs only epochs. As in MATLAB, only a strictly worse validation loss is a failure
 (a rejected SCG step leaves the weights, and the loss, unchanged)."""
 from __future__ import annotations

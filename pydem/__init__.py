@@ -11,7 +11,7 @@ import os as _os
 # once (OMP_WAIT_POLICY=passive) made a small rig run on 2 threads slower than on 1 (hopper
 # `default`: 8.0 s against 5.5 s; with the short spin 3.5 s); spinning long made a 2-thread run
 # beside a busy process 2x slower than 1 thread. The busy machine is now libdem's thread
-# governor's job (it drops to fewer threads while they measure faster; bench/README.md, "A busy
+# governor's job (it drops to fewer threads while they measure faster; studies/JOURNAL.md, "A busy
 # machine"). Set before libdem loads libgomp; an explicit OMP_WAIT_POLICY or GOMP_SPINCOUNT wins.
 if "OMP_WAIT_POLICY" not in _os.environ and "GOMP_SPINCOUNT" not in _os.environ:
     _os.environ["GOMP_SPINCOUNT"] = "10000"

@@ -5,10 +5,10 @@ plus lab noise (pydem.calibration.synthetic). The truth goes into the file's com
     .venv/bin/python scripts/make_synthetic_material.py --effect cohesion_sjkr --strength 6e4 \\
         --name synthetic_cohesive --out data/measurements/synthetic_cohesive.csv
 
-or from a set that bench/diagnosis_dem_sets.py already ran (its journal keeps the rigs' raw
+or from a set that studies/diagnosis_dem_sets.py already ran (its journal keeps the rigs' raw
 values and the truth; only the lab noise is drawn here):
 
-    .venv/bin/python scripts/make_synthetic_material.py --journal bench/results/dem_sets_default.jsonl \\
+    .venv/bin/python scripts/make_synthetic_material.py --journal studies/results/dem_sets_default.jsonl \\
         --set 1 --preset default --name synthetic_cohesive --out data/measurements/synthetic_cohesive.csv
 """
 from __future__ import annotations

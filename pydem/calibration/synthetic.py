@@ -270,7 +270,7 @@ def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth,
 
 def journal_set(row: dict, nets: dict, candidates: list[Candidate], rng: np.random.Generator,
                 keep=None) -> tuple[Truth, list[Observation]]:
-    """A set from a bench/diagnosis_dem_sets.py journal line (the rigs' raw values and the truth):
+    """A set from a studies/diagnosis_dem_sets.py journal line (the rigs' raw values and the truth):
     its truth and its rows with lab noise drawn now (rows whose run failed, or that `keep`
     rejects, left out)."""
     t = row["truth"]

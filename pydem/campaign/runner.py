@@ -193,7 +193,7 @@ class Campaign:
 
     def default_workers(self) -> int:
         """Runs side by side by default: one per core for the runs' thread count (on 2 cores two
-        1-thread runs beat one 2-thread run: bench/README.md, campaign throughput)."""
+        1-thread runs beat one 2-thread run: studies/JOURNAL.md, campaign throughput)."""
         threads = int(self.store.spec.fixed.get("num_threads", 1))
         return max(1, (os.cpu_count() or 1) // threads)
 

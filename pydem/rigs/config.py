@@ -15,7 +15,7 @@ def default_threads() -> int:
     (users and batch systems set it), else the cores this process may use. libdem's thread
     governor runs the steps on fewer threads while that measures faster — a busy machine, a
     system too small for the team — so asking for every core no longer costs: a 2-thread run
-    beside a busy process takes about its 1-thread time (bench/README.md, "Threads that measure
+    beside a busy process takes about its 1-thread time (studies/JOURNAL.md, "Threads that measure
     themselves"). Campaigns run one thread per run, several runs side by side."""
     text = os.environ.get("OMP_NUM_THREADS", "").split(",")[0].strip()
     try:

@@ -53,7 +53,7 @@ class HopperConfig:
     density_boxes: str = knob("below_highest", doc="where the bulk density is measured: three boxes ending two "
                               "diameters below the highest sphere (the tiny preset's), or below the free surface's "
                               "lowest point (the default preset's since 2026-11-27: a sloped surface leaves the "
-                              "former's top box part empty, seed scatter 43 -> 14 kg/m^3, bench/hopper_bulk_density.py)",
+                              "former's top box part empty, seed scatter 43 -> 14 kg/m^3, studies/hopper_bulk_density.py)",
                               choices=("below_highest", "below_surface"))
     max_time: float = knob(30.0, 0.1, 3600.0, "s", "discharge time limit")
     jam_time: float = knob(1.0, 0.01, 60.0, "s", "no outflow for this long: jammed")

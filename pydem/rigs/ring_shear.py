@@ -67,10 +67,10 @@ class RingShearConfig:
         if name == "cell":  # ~2 minutes on one core: the smallest cell found that feels mu_s (campaigns)
             # 8 d wide, ~7 d deep, bars of 1 d: in the tiny cell the shear localises under the lid
             # and mu_ie-ps even falls with mu_s; here it rises (0.536 -> 0.594 for mu_s 0.2 -> 0.8 at
-            # mu_r 0.1, seed sd 0.017; bench/results/ring_shear_design.txt). First pre-shear 20 mm.
+            # mu_r 0.1, seed sd 0.017; studies/results/ring_shear_design.txt). First pre-shear 20 mm.
             # The peak of one shear to failure scatters by ~0.04 (sd) between repeats in this small
             # cell, as much as mu_s moves it: six repeats, each after a 3 mm (1 d) pre-shear that
-            # restores steady flow, average it to ~0.015 (bench/results/ring_shear_design.txt).
+            # restores steady flow, average it to ~0.015 (studies/results/ring_shear_design.txt).
             return cls(particles=4300, diameter=3e-3, inner_radius=0.02, outer_radius=0.044, bars=12, bar_height=3e-3,
                        shear_points=[0.5], shear_repeats=6, preshear_displacement=3e-3, first_preshear_displacement=2e-2,
                        max_preshear=3e-2, shear_displacement=3e-3, shear_speed=0.05)

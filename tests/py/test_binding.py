@@ -249,7 +249,7 @@ def test_shear_modulus_apart_from_e_and_nu_sets_the_tangential_stiffness():
 
 def test_openmp_threads_spin_briefly_unless_the_user_chose():
     """pydem asks libgomp for a short spin at barriers before libdem loads it (a small rig on
-    2 threads ran slower than on 1 with passive waiting, bench/README.md); a user's own choice
+    2 threads ran slower than on 1 with passive waiting, studies/JOURNAL.md); a user's own choice
     wins."""
     import os
     import subprocess

@@ -327,7 +327,7 @@ def test_measurements_that_match_no_campaign_are_refused(tmp_path):
 
 def test_validation_protocol_on_the_shipped_tiny_stores():
     """The hidden-effect protocol end to end on the shipped tiny stores (a small version of
-    bench/diagnosis_validation.py): surrogate sets with and without a hidden effect and with a
+    studies/diagnosis_validation.py): surrogate sets with and without a hidden effect and with a
     non-candidate discrepancy, and one set made by the rigs themselves. Seeded and run on shipped
     nets, so the verdicts are fixed: a strong cohesion is named, a null set raises no alarm, and
     a 25 % density mismatch shows as misfit."""
@@ -361,7 +361,7 @@ def test_validation_protocol_on_the_shipped_tiny_stores():
     assert all(r["truth_error_after"] is None and r["truth_error_before"] > 0 for r in rows if r["kind"] == "null")
     assert all(r["verdict"] == "no_effect_needed" for r in rows if r["kind"] == "null"), rows
     # a 25 % density mismatch (no candidate) is seen as misfit; with the tiny stores wall friction
-    # often absorbs it (bench/README.md), so its verdict is not asserted
+    # often absorbs it (studies/JOURNAL.md), so its verdict is not asserted
     worst_null = max(r["chi2_before"] for r in rows if r["kind"] == "null")
     assert all(r["chi2_before"] > worst_null for r in rows if r["kind"] == "unexplained"), rows
     dem = synthetic.validate(setup, {"null": 1}, seed=13, source="dem", say=lambda *a: None)

@@ -71,7 +71,7 @@ def test_tiny_run_is_plausible(tiny_runs):
 
 def test_angle_rises_with_rolling_friction(tiny_runs):
     """At this scale (a heap a few spheres high on a rough base) only a large change shows
-    beyond the quadrant scatter; the default-scale sweep is bench/plausibility_aor.py."""
+    beyond the quadrant scatter; the default-scale sweep is studies/plausibility.py aor."""
     low, high = tiny_runs[0.0].metrics["angle_of_repose"], tiny_runs[0.6].metrics["angle_of_repose"]
     assert high.value > low.value + 2 * np.hypot(high.uncertainty, low.uncertainty)
 

@@ -96,11 +96,11 @@ def test_fit_keeps_a_given_target_scaling():
 
 
 def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
-    """bench/seed001_device.py runs on GPU machines where libdem is not built: pydem's frame
+    """studies/seed001_device.py runs on GPU machines where libdem is not built: pydem's frame
     store and Table 1 must import there without the binding."""
     import subprocess
     import sys
-    code = ("import sys; sys.path.insert(0, 'bench'); import seed001_device as d; d.import_without_binding(); "
+    code = ("import sys; sys.path.insert(0, 'studies'); import seed001_device as d; d.import_without_binding(); "
             "import pydem.seed001.cli, pydem.seed001.store, pydem.rigs.table1, nn.training; "
             "assert 'pydem._libdem' not in sys.modules; print(len(pydem.rigs.table1.TABLE1))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,

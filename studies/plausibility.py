@@ -1,11 +1,11 @@
 """Plausibility sweeps of the rigs (issue 4), with committed results and plots.
 
-    .venv/bin/python bench/plausibility.py aor          # angle vs mu_r and vs mu_s
-    .venv/bin/python bench/plausibility.py ring-shear   # mu_ie-ps vs mu_s; cohesion -> intercept
-    .venv/bin/python bench/plausibility.py hopper       # Beverloo over slot widths
-    .venv/bin/python bench/plausibility.py plot         # redraw the plots from the CSVs
+    .venv/bin/python studies/plausibility.py aor          # angle vs mu_r and vs mu_s
+    .venv/bin/python studies/plausibility.py ring-shear   # mu_ie-ps vs mu_s; cohesion -> intercept
+    .venv/bin/python studies/plausibility.py hopper       # Beverloo over slot widths
+    .venv/bin/python studies/plausibility.py plot         # redraw the plots from the CSVs
 
-Each finished point is appended to bench/results/plausibility/<sweep>.jsonl at once, and points
+Each finished point is appended to studies/results/plausibility/<sweep>.jsonl at once, and points
 already there are skipped: a killed sweep resumes where it stopped.
 """
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-OUT = ROOT / "bench" / "results" / "plausibility"
+OUT = ROOT / "studies" / "results" / "plausibility"
 
 from pydem.rigs import (AngleOfRepose, AorConfig, Hopper, HopperConfig, RingShear, RingShearConfig,  # noqa: E402
                         beverloo_fit, load)

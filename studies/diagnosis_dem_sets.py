@@ -6,12 +6,12 @@ hopper at three slot widths) and appends the raw values to a journal (resumable:
 set); `diagnose` adds the lab noise, writes each set as a measurement file and runs the
 diagnosis on the given stores.
 
-    .venv/bin/python bench/diagnosis_dem_sets.py run --kinds null cohesion_sjkr --journal bench/results/dem_sets_default.jsonl
-    .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl
-    .venv/bin/python bench/diagnosis_dem_sets.py diagnose --journal bench/results/dem_sets_default.jsonl --kinds null \
-        --density-factor 1.25 --out bench/results/dem_sets_default.density125.diagnosed.json
-    .venv/bin/python bench/diagnosis_dem_sets.py rerun --rig aor --journal bench/results/dem_sets_default.jsonl
-    .venv/bin/python bench/diagnosis_dem_sets.py summary      (every bench/results/dem_sets_default*.diagnosed.json)
+    .venv/bin/python studies/diagnosis_dem_sets.py run --kinds null cohesion_sjkr --journal studies/results/dem_sets_default.jsonl
+    .venv/bin/python studies/diagnosis_dem_sets.py diagnose --journal studies/results/dem_sets_default.jsonl
+    .venv/bin/python studies/diagnosis_dem_sets.py diagnose --journal studies/results/dem_sets_default.jsonl --kinds null \
+        --density-factor 1.25 --out studies/results/dem_sets_default.density125.diagnosed.json
+    .venv/bin/python studies/diagnosis_dem_sets.py rerun --rig aor --journal studies/results/dem_sets_default.jsonl
+    .venv/bin/python studies/diagnosis_dem_sets.py summary      (every studies/results/dem_sets_default*.diagnosed.json)
 """
 from __future__ import annotations
 
@@ -166,7 +166,7 @@ def error_fall_text(sets: list[dict]) -> str:
 def summary(args):
     """Top-1 per kind, false alarms, the error fall and the density-mismatch verdicts over every
     diagnosed journal matching the pattern (the density-mismatch files counted apart)."""
-    files = sorted(Path(ROOT / "bench" / "results").glob(args.pattern))
+    files = sorted(Path(ROOT / "studies" / "results").glob(args.pattern))
     plain = [f for f in files if ".density" not in f.name]
     sets = [s for f in plain for s in json.loads(f.read_text())]
     print(f"{len(sets)} sets in {len(plain)} files")
@@ -219,7 +219,7 @@ def main() -> int:
     e.add_argument("--rig", required=True)
     e.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
     m = sub.add_parser("summary", help="the figures over every diagnosed journal")
-    m.add_argument("--pattern", default="dem_sets_default*.diagnosed.json", help="files in bench/results")
+    m.add_argument("--pattern", default="dem_sets_default*.diagnosed.json", help="files in studies/results")
     args = ap.parse_args()
     {"run": run, "diagnose": diagnose, "rerun": rerun, "summary": summary}[args.cmd](args)
     return 0

@@ -2,7 +2,7 @@
 friction 0.3), different seeds. The scatter bounds the hold-out R^2 any surrogate can reach:
 R^2 <= 1 - sd_noise^2 / sd_campaign^2.
 
-    .venv/bin/python bench/aor_scatter.py tiny 6       # preset, number of seeds
+    .venv/bin/python studies/aor_scatter.py tiny 6       # preset, number of seeds
 """
 import sys
 

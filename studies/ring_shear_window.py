@@ -3,7 +3,7 @@ at mu_s 0.2 and 0.8 (mu_r 0.1, e 0.5), a few seeds, two processes; then mu_ie-ps
 mean sigma over windows of the shear displacement, with the seed-to-seed scatter per window.
 A usable design: the mean rises with mu_s, and the scatter falls with the window length.
 
-    .venv/bin/python bench/ring_shear_window.py PRESET "key=value,..." [seeds] [displacement_m]
+    .venv/bin/python studies/ring_shear_window.py PRESET "key=value,..." [seeds] [displacement_m]
 """
 import sys
 from multiprocessing import Pool

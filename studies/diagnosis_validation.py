@@ -3,10 +3,10 @@ top-1 accuracy per candidate effect, false alarms on null sets, the error after 
 effect as a fraction of before, and what an effect that is not a candidate (a solid-density
 mismatch) gets called.
 
-    .venv/bin/python bench/diagnosis_validation.py --source surrogate --sets 40 --null 200
-    .venv/bin/python bench/diagnosis_validation.py --source dem --sets 3 --null 3
+    .venv/bin/python studies/diagnosis_validation.py --source surrogate --sets 40 --null 200
+    .venv/bin/python studies/diagnosis_validation.py --source dem --sets 3 --null 3
 
-Writes bench/results/diagnosis_validation_<preset>_<source>.json (every set and the scores)."""
+Writes studies/results/diagnosis_validation_<preset>_<source>.json (every set and the scores)."""
 from __future__ import annotations
 
 import argparse
@@ -42,11 +42,11 @@ def main() -> int:
     setup = load_setup([s for s in stores if s.exists()])
     kinds = {"null": args.null, **{c.name: args.sets for c in setup.candidates}, "unexplained": args.unexplained}
     t0 = time.perf_counter()
-    journal = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.jsonl"  # resumable
+    journal = ROOT / f"studies/results/diagnosis_validation_{args.preset}_{args.source}.jsonl"  # resumable
     rows = synthetic.validate(setup, kinds, seed=args.seed, source=args.source, threads=args.threads, journal=journal,
                               net_error=not args.exact_nets)
     scores = synthetic.score_sets(rows)
-    out = ROOT / f"bench/results/diagnosis_validation_{args.preset}_{args.source}.json"
+    out = ROOT / f"studies/results/diagnosis_validation_{args.preset}_{args.source}.json"
     out.parent.mkdir(exist_ok=True)
     meta = {"date": time.strftime("%Y-%m-%d"), "machine": f"{platform.machine()}, {len(__import__('os').sched_getaffinity(0))} cores",
             "seconds": time.perf_counter() - t0, "stores": [str(s.relative_to(ROOT)) if s.is_relative_to(ROOT) else str(s) for s in stores if s.exists()],

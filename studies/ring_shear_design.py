@@ -1,7 +1,7 @@
 """Friction sensitivity and scatter of a ring-shear cell design: mu_ie-ps at mu_s 0.1 and 0.9
 (mu_r 0), two seeds each, tiny preset plus the overrides given (comma-separated key=value).
 
-    .venv/bin/python bench/ring_shear_design.py "particles=2400,bar_height=3e-3"
+    .venv/bin/python studies/ring_shear_design.py "particles=2400,bar_height=3e-3"
 """
 import sys
 import time

@@ -7,8 +7,8 @@ gauges fitted on the case's own whole discharge (`*_own`: quintics; what no read
 hopper has): how well one discharge's frames fix its own count, against how well a law carries
 from other hoppers.
 
-    .venv/bin/python bench/nrrp_gauges.py --store data/seed001/frames_full.h5 --size 224 \\
-        --process bench/results/seed001_gpu/process.json --out bench/results/seed001_gpu/process_gauges.json
+    .venv/bin/python studies/nrrp_gauges.py --store data/seed001/frames_full.h5 --size 224 \\
+        --process studies/results/seed001_gpu/process.json --out studies/results/seed001_gpu/process_gauges.json
 """
 from __future__ import annotations
 

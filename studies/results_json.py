@@ -1,4 +1,4 @@
-"""One results file for the diagnosis benches: bench/results/<name>.json with when, where, the
+"""One results file for the diagnosis benches: studies/results/<name>.json with when, where, the
 command and how long it took, beside the table and every set."""
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 # libdem against LIGGGHTS on the same packed bed (DESIGN section 10: 20,088 spheres, Hertz with
 # tangential history, EPSD2 rolling at mu_r 0.1 and without rolling friction, dt 1e-5 s, skin
 # 0.2 mm), one core each, alternating: settle 20,000 steps from the lattice, then time 5,000.
-#   [NSIDE=40] [MU_R='0.1 0.0'] sh bench/liggghts_bed.sh LMP_SERIAL [rounds]   (NSIDE 40: the 99,200-sphere bed)
+#   [NSIDE=40] [MU_R='0.1 0.0'] sh studies/liggghts_bed.sh LMP_SERIAL [rounds]   (NSIDE 40: the 99,200-sphere bed)
 # LMP_SERIAL: a LIGGGHTS-PUBLIC serial build (fetch github:CFDEMproject/LIGGGHTS-PUBLIC, then in
 # src/: make stubs; make serial CCFLAGS="-O3 -march=native -fPIC -std=c++11 -w"). Prints one line
 # per run (M particle-steps/s and contacts per particle of the timed part) and the median ratio.

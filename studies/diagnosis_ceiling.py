@@ -13,16 +13,16 @@ alarm level. Two versions:
 - with the nets' own error set to zero: the ceiling of the protocol itself (its conditions, its
   lab noise and the rigs' seed scatter), whatever the surrogates.
 
-    .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30
-    .venv/bin/python bench/diagnosis_ceiling.py --preset default --sets 30 --floor 0   # strengths from 0
-    .venv/bin/python bench/diagnosis_ceiling.py --preset default --dem   # the DEM-made sets' truths
+    .venv/bin/python studies/diagnosis_ceiling.py --preset default --sets 30
+    .venv/bin/python studies/diagnosis_ceiling.py --preset default --sets 30 --floor 0   # strengths from 0
+    .venv/bin/python studies/diagnosis_ceiling.py --preset default --dem   # the DEM-made sets' truths
 
 With --dem, the sets are those of the committed DEM-made journals (`dem_sets_default*.jsonl`): each
 set's signal is taken on the surrogates at its truth with its rows' stated uncertainties (the
 rigs' own mean response is unknown), and the oracle is set beside the verdicts in
 `*.diagnosed.json`.
 
-Writes bench/results/diagnosis_ceiling_<label>.json and prints the table."""
+Writes studies/results/diagnosis_ceiling_<label>.json and prints the table."""
 from __future__ import annotations
 
 import argparse
@@ -113,7 +113,7 @@ def dem_ceiling(setup, args) -> int:
     from pydem.calibration.quantities import Quantity
     t0 = time.perf_counter()
     rows = []
-    for journal in sorted((ROOT / "bench/results").glob("dem_sets_default*.jsonl")):
+    for journal in sorted((ROOT / "studies/results").glob("dem_sets_default*.jsonl")):
         diagnosed = journal.with_suffix(".diagnosed.json")
         if not diagnosed.exists():
             continue

@@ -2,11 +2,11 @@
 each rig's tiny preset at several seeds, and points of the shipped aor_default campaign at the
 default preset, with the pydem of a given checkout (old: a worktree of the last 0.1 commit).
 
-    .venv/bin/python bench/contact_law_shift.py --root /tmp/old --label libdem-0.1
-    .venv/bin/python bench/contact_law_shift.py --root . --label libdem-0.2
-    .venv/bin/python bench/contact_law_shift.py --compare libdem-0.1 libdem-0.2
+    .venv/bin/python studies/contact_law_shift.py --root /tmp/old --label libdem-0.1
+    .venv/bin/python studies/contact_law_shift.py --root . --label libdem-0.2
+    .venv/bin/python studies/contact_law_shift.py --compare libdem-0.1 libdem-0.2
 
-Rows go to bench/results/contact_law_shift.jsonl (appended; a finished row is not run again)."""
+Rows go to studies/results/contact_law_shift.jsonl (appended; a finished row is not run again)."""
 from __future__ import annotations
 
 import argparse
@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
-OUT = HERE / "bench/results/contact_law_shift.jsonl"
+OUT = HERE / "studies/results/contact_law_shift.jsonl"
 SEEDS = (1, 2, 3, 4)
 TINY = {"aor": {}, "ring-shear": {}, "hopper": {}}
 DEFAULT_POINTS = (0, 1, 2)  # design points of data/campaigns/aor_default.h5

@@ -6,9 +6,9 @@ set's own measurements would detect (detectability.py, at the set's base fit): a
 effect lies beyond that limit should be named in about 90 % of cases or more, one inside it
 rarely.
 
-    .venv/bin/python bench/diagnosis_detectability.py --preset default --sets 30
+    .venv/bin/python studies/diagnosis_detectability.py --preset default --sets 30
 
-Writes bench/results/diagnosis_detectability_<preset>.json and prints the table."""
+Writes studies/results/diagnosis_detectability_<preset>.json and prints the table."""
 from __future__ import annotations
 
 import argparse

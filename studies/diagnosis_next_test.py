@@ -9,9 +9,9 @@ list (`detectability.candidate_tests`). The user does not know which effect is h
 the suggestion for the true one, so it answers "if you suspect this effect, does the suggested
 test find it more often than another test would?"
 
-    .venv/bin/python bench/diagnosis_next_test.py --preset default --sets 30
+    .venv/bin/python studies/diagnosis_next_test.py --preset default --sets 30
 
-Writes bench/results/diagnosis_next_test_<preset>.json and prints the table."""
+Writes studies/results/diagnosis_next_test_<preset>.json and prints the table."""
 from __future__ import annotations
 
 import argparse

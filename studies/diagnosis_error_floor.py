@@ -9,9 +9,9 @@ RMS of e / f over the rows: what even a perfect fit keeps), each quantity's shar
 and the ratio a perfect diagnosis would reach, floor / sqrt(shift^2 + floor^2) (medians over
 the draws).
 
-    .venv/bin/python bench/diagnosis_error_floor.py [--stores ...] [--draws 150] [--label default]
+    .venv/bin/python studies/diagnosis_error_floor.py [--stores ...] [--draws 150] [--label default]
 
-Writes bench/results/diagnosis_error_floor_<label>.txt. ~30 s on one core."""
+Writes studies/results/diagnosis_error_floor_<label>.txt. ~30 s on one core."""
 from __future__ import annotations
 
 import argparse
@@ -65,7 +65,7 @@ def main() -> int:
     args = ap.parse_args()
     setup = load_setup(args.stores, say=lambda *_: None)
     lines = floor_table(setup, args.draws)
-    out = ROOT / f"bench/results/diagnosis_error_floor_{args.label}.txt"
+    out = ROOT / f"studies/results/diagnosis_error_floor_{args.label}.txt"
     out.write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     print(f"-> {out}")

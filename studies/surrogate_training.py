@@ -1,7 +1,7 @@
 """How good can any surrogate be on a campaign, and how close do the MLPs get?
 
-    .venv/bin/python bench/surrogate_training.py data/campaigns/ring_shear_cell.h5 --runs 105
-    .venv/bin/python bench/surrogate_training.py data/campaigns/aor_default.h5 --metrics angle_of_repose
+    .venv/bin/python studies/surrogate_training.py data/campaigns/ring_shear_cell.h5 --runs 105
+    .venv/bin/python studies/surrogate_training.py data/campaigns/aor_default.h5 --metrics angle_of_repose
 
 Per metric, on the design points' means (replicates averaged):
 1. a Gaussian process (ARD squared-exponential kernel + a noise term, maximum marginal
@@ -12,7 +12,7 @@ Per metric, on the design points' means (replicates averaged):
 3. the MLPs as `nn.mlp.train_net` trains them, against the early-stopping patience: single
    nets of 4 and 8 tanh units, 5 hold-out draws (15 %) x 4 restarts, mean hold-out R^2.
 `--runs N` uses only the first N rows of the store (a growing store then gives the same
-answer). Results: bench/results/surrogate_training.txt. ~1-2 min per metric on one core."""
+answer). Results: studies/results/surrogate_training.txt. ~1-2 min per metric on one core."""
 import argparse
 import itertools
 

@@ -4,9 +4,9 @@ this runner imports pydem's pure-Python modules (the frame store, Table 1) witho
 and then runs `pydem images`' own command line (pydem/seed001/cli.py) with the same arguments.
 The seed-scale comparison of docs/seed001.md (224 x 224, every frame):
 
-    python3 bench/seed001_device.py compare --store data/seed001/frames_full.h5 --out OUT \\
+    python3 studies/seed001_device.py compare --store data/seed001/frames_full.h5 --out OUT \\
         --size 224 --every 1 --epochs 30 --time-budget 75 --checkpoints /tmp/seed001_checkpoints
-    python3 bench/seed001_device.py point-to-point --store data/seed001/frames_full.h5 --out OUT \\
+    python3 studies/seed001_device.py point-to-point --store data/seed001/frames_full.h5 --out OUT \\
         --size 224 --every 1 --epochs 30 --checkpoints /tmp/seed001_checkpoints
 
 (checkpoints outside OUT: a VGG's is 1.6 GB)."""
@@ -41,7 +41,7 @@ def import_without_binding():
 def main(argv=None) -> int:
     import_without_binding()
     from pydem.seed001.cli import main as seed001
-    return seed001(argv, prog="bench/seed001_device.py")
+    return seed001(argv, prog="studies/seed001_device.py")
 
 
 if __name__ == "__main__":

@@ -2,10 +2,10 @@
 an ARD squared-exponential GP (hyperparameters by maximum marginal likelihood, analytic gradient,
 two starts) on exactly the training tables, folds and run grouping that
 pydem.calibration.surrogates uses, on the raw and the log target; compare with the `rmse` and
-`r2` in each cached net's meta (printed beside). A tried-and-dropped check (bench/README.md,
+`r2` in each cached net's meta (printed beside). A tried-and-dropped check (studies/JOURNAL.md,
 "Gaussian-process surrogates"), not part of the product.
 
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python bench/gp_surrogates.py [stores ...]
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/gp_surrogates.py [stores ...]
 """
 import sys
 import time

@@ -3,7 +3,7 @@
 and each widened to d (1 +- 0.5), three seeds each; max_overlap_ratio 0.6 as the size-spread
 campaign sets it (at 0.5 a coarse sphere landing on a fine one while filling passes 0.3).
 
-    .venv/bin/python bench/hopper_size_spread.py > bench/results/hopper_size_spread.txt
+    .venv/bin/python studies/hopper_size_spread.py > studies/results/hopper_size_spread.txt
 """
 import sys
 import time

@@ -6,9 +6,9 @@
   cohesion's effect on the friction coefficients scales with);
 - the bag: 4 members of 10 units (shipped for the mu nets) / 8 of 10 / 8 of 16 / 16 of 10.
 
-    .venv/bin/python bench/surrogate_variants.py [--stores ...]
+    .venv/bin/python studies/surrogate_variants.py [--stores ...]
 
-Writes bench/results/surrogate_variants.txt. ~3 min on one core."""
+Writes studies/results/surrogate_variants.txt. ~3 min on one core."""
 from __future__ import annotations
 
 import argparse
@@ -52,7 +52,7 @@ def main() -> int:
             cv = cross_validate(xx, y, groups, hidden, bag, folds=5, seed=0, log_target=log_target)
             lines.append(f"{q.key:24s} {label:36s} R^2 {cv['r2']:.4f}  RMSE {cv['rmse']:.5g}  ({time.perf_counter() - t0:.0f} s)")
             print(lines[-1], flush=True)
-    out = ROOT / "bench/results/surrogate_variants.txt"
+    out = ROOT / "studies/results/surrogate_variants.txt"
     out.write_text("\n".join(lines) + "\n")
     print(f"-> {out}")
     return 0

@@ -8,9 +8,9 @@ The hoppers are drawn by pydem.rigs.table1.draw_like_table1. Each runs
 at full size with a frame every `--frame-interval` into its own store (resumable: hoppers
 already stored are skipped), two at a time.
 
-    .venv/bin/python bench/nrrp_more_hoppers.py run --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
-    .venv/bin/python bench/nrrp_more_hoppers.py evaluate --packing B1 --store data/seed001/extra_B1.h5 \\
-        --table1 data/seed001/frames_full.h5 --out bench/results/seed001/nrrp_more_hoppers_B1.json
+    .venv/bin/python studies/nrrp_more_hoppers.py run --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
+    .venv/bin/python studies/nrrp_more_hoppers.py evaluate --packing B1 --store data/seed001/extra_B1.h5 \\
+        --table1 data/seed001/frames_full.h5 --out studies/results/seed001/nrrp_more_hoppers_B1.json
 """
 from __future__ import annotations
 

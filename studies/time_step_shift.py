@@ -7,8 +7,8 @@ contact (14: dt at the Rayleigh bound) — and reports the CPU-time ratio and, p
 mean paired shift (coarse - shipped) with its standard error against one run's seed sd. A
 shift many standard errors from zero is a bias every store run would carry.
 
-    .venv/bin/python bench/time_step_shift.py --rig hopper --seeds 8 [--steps-per-contact 14]
-        [--out bench/results/time_step_shift_hopper.txt]
+    .venv/bin/python studies/time_step_shift.py --rig hopper --seeds 8 [--steps-per-contact 14]
+        [--out studies/results/time_step_shift_hopper.txt]
 """
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ def main() -> None:
     ap.add_argument("--steps-per-contact", type=int, default=14)
     ap.add_argument("--out")
     a = ap.parse_args()
-    lines = [f"# bench/time_step_shift.py --rig {a.rig} --seeds {a.seeds} --steps-per-contact {a.steps_per_contact} "
+    lines = [f"# studies/time_step_shift.py --rig {a.rig} --seeds {a.seeds} --steps-per-contact {a.steps_per_contact} "
              f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}); default preset at {CENTRE}, one thread"]
     shipped, coarse, cpu = [], [], []
     for seed in range(1, a.seeds + 1):

@@ -7,7 +7,7 @@ other in a DEM null set), so the first's top box is part empty and one run reads
 stored value, in the store's own measure, printed beside: the run reproduces it); prints each
 run's two values and the pooled seed-to-seed sd of each measure.
 
-    .venv/bin/python bench/hopper_bulk_density.py [--runs N] [--workers 2] > bench/results/hopper_bulk_density.txt
+    .venv/bin/python studies/hopper_bulk_density.py [--runs N] [--workers 2] > studies/results/hopper_bulk_density.txt
 """
 import argparse
 import math

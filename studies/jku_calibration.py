@@ -8,7 +8,7 @@ table says how narrow each parameter still gets. Beside each estimate: what the 
 shear surrogates predict for it (pre-shear 2 kPa, shear point 60 %, the candidate effects at
 neutral), flagged where the estimate lies outside the ring-shear store's box.
 
-    .venv/bin/python bench/jku_calibration.py [--stores S ...]  # -> bench/results/jku_calibration.{json,md}
+    .venv/bin/python studies/jku_calibration.py [--stores S ...]  # -> studies/results/jku_calibration.{json,md}
 """
 from __future__ import annotations
 
@@ -69,7 +69,7 @@ def main() -> int:
         print(f"{name:18s} {obs[0].value:6.2f} deg  model {model:6.2f}  admissible {c.screening['admissible']:7d}  "
               + "  ".join(f"{k} {p['mean']:.3f} [{p['lo']:.3f}, {p['hi']:.3f}]{'*' if p['at_edge'] else ''}"
                           for k, p in post.items()), flush=True)
-    out = ROOT / "bench/results/jku_calibration.json"
+    out = ROOT / "studies/results/jku_calibration.json"
     out.write_text(json.dumps({"stores": list(stores), "surrogates": fits, "materials": rows}, indent=1))
     lines = [f"Stores: {', '.join(stores)}; surrogates (hold-out R², RMSE): "
              + "; ".join(f"{k} {r2:.2f}, {rmse:.3g}" for k, (r2, rmse) in fits.items()), "",

@@ -4,7 +4,7 @@ failure at 50 % of sigma_pre) for a few seeds, two processes, and prints per see
 ratios, their mean and standard error, mu_ie-ps and the wall time. Repeats are as good as
 seeds when the seed means agree within their standard errors.
 
-    .venv/bin/python bench/ring_shear_repeats.py [friction] [rolling_friction] [repeats] [preshear_m] [seeds]
+    .venv/bin/python studies/ring_shear_repeats.py [friction] [rolling_friction] [repeats] [preshear_m] [seeds]
 """
 import sys
 from multiprocessing import Pool

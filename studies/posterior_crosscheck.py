@@ -13,8 +13,8 @@ implementations: the means and standard deviations must agree within the samplin
 
 GrainLearning needs numpy < 2, so it runs in a venv of its own:
     python3 -m venv /tmp/glvenv && /tmp/glvenv/bin/pip install "numpy<2" grainlearning cffi h5py scipy
-    /tmp/glvenv/bin/python bench/posterior_crosscheck.py [--sets 6]
-Writes bench/results/posterior_crosscheck.json."""
+    /tmp/glvenv/bin/python studies/posterior_crosscheck.py [--sets 6]
+Writes studies/results/posterior_crosscheck.json."""
 from __future__ import annotations
 
 import argparse
@@ -80,7 +80,7 @@ def main() -> int:
             print(f"set {k} {name:18s} pydem {p['mean']:.4f} ± {p['sd']:.4f}   GrainLearning {gl_mean[j]:.4f} ± "
                   f"{gl_sd[j]:.4f}   (ESS {ours['ess']:.0f} / {gl_ess:.0f})")
         rows.append(row)
-    out = ROOT / "bench/results/posterior_crosscheck.json"
+    out = ROOT / "studies/results/posterior_crosscheck.json"
     diffs = [abs(p["mean_difference_in_sd"]) for r in rows for p in r["parameters"].values()]
     ratios = [p["sd_ratio"] for r in rows for p in r["parameters"].values()]
     summary = {"sets": len(rows), "max_abs_mean_difference_in_sd": max(diffs), "median_abs_mean_difference_in_sd":
