@@ -2,7 +2,8 @@
 #   make            static + shared library (strict warnings, warnings are errors); no Python needed
 #   make pydem      the Python binding in place (pydem/_libdem*.so; the set-up makes .venv)
 #   make test       set-up (idempotent), build, every C test (plain, then under ASan/UBSan),
-#                   then the Python tests
+#                   then the Python tests; prints the slowest tests and each stage's time
+#   make test-quick the edit-test loop (a few minutes): the C tests once, the Python tests not marked slow
 #   make bench      benchmarks (results in bench/results/)
 #   make demo       the main job (calibration of glass microbeads, report in build/calibration;
 #                   the diagnosis loop, reports in build/diagnosis)
@@ -39,7 +40,7 @@ TEST_BIN := $(patsubst tests/c/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all lib pydem setup test test-c test-sanitize test-minimal test-py bench bench-screening demo install clean FORCE
+.PHONY: all lib pydem setup test test-quick test-c test-sanitize test-minimal test-py bench bench-screening demo install clean FORCE
 
 all: lib
 lib: $(BUILD)/libdem.a $(BUILD)/libdem.so $(BUILD)/dem.pc
@@ -78,8 +79,18 @@ $(BUILD)/tests/%: tests/c/%.c $(wildcard tests/c/*.h) $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< -o $@ $(BUILD)/libdem.a -lcmocka $(LDLIBS)
 
+# each stage timed; the total goes into the CHANGELOG at each release
 test: setup
-	@$(MAKE) --no-print-directory test-c test-sanitize test-minimal test-py
+	@t0=$$(date +%s); for stage in test-c test-sanitize test-minimal test-py; do \
+	  s=$$(date +%s); $(MAKE) --no-print-directory $$stage || exit 1; \
+	  echo "== $$stage: $$(( $$(date +%s) - s )) s"; done; \
+	echo "== make test passed in $$(( $$(date +%s) - t0 )) s"
+
+# the edit-test loop: the C tests once (no sanitizers), the Python tests not marked slow
+test-quick: setup
+	@t0=$$(date +%s); $(MAKE) --no-print-directory test-c && \
+	  $(MAKE) --no-print-directory PYTEST_ARGS='-m "not slow"' test-py && \
+	  echo "== make test-quick passed in $$(( $$(date +%s) - t0 )) s"
 
 # libdem without HDF5 and libpng (HDF5=0 PNG=0), linked without them
 test-minimal:
@@ -99,14 +110,14 @@ test-sanitize:
 	  || (cat $(BUILD)/sanitize.log; echo "sanitizer run FAILED (log: $(BUILD)/sanitize.log)"; exit 1)
 	@grep -cE "^\[  PASSED  \]" $(BUILD)/sanitize.log | xargs printf "   %s test programs passed (log: $(BUILD)/sanitize.log)\n"
 
-test-c: lib $(TEST_BIN) $(BUILD)/readme_example
+test-c: lib $(TEST_BIN) $(BUILD)/libdem_example
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; OMP_NUM_THREADS=2 $$t; done
-	@echo "== README example"; $(BUILD)/readme_example
+	@echo "== docs/libdem.md example"; $(BUILD)/libdem_example
 
-$(BUILD)/readme_example: README.md $(BUILD)/libdem.a
+$(BUILD)/libdem_example: docs/libdem.md $(BUILD)/libdem.a
 	@mkdir -p $(BUILD)
-	sed -n '/^```c readme-example/,/^```/p' README.md | sed '1d;$$d' > $(BUILD)/readme_example.c
-	$(CC) $(CFLAGS) $(BUILD)/readme_example.c -o $@ $(BUILD)/libdem.a $(LDLIBS)
+	sed -n '/^```c libdem-example/,/^```/p' docs/libdem.md | sed '1d;$$d' > $(BUILD)/libdem_example.c
+	$(CC) $(CFLAGS) $(BUILD)/libdem_example.c -o $@ $(BUILD)/libdem.a $(LDLIBS)
 
 # the Python binding (cffi, API mode) over the headers and the static library
 PYDEM_STAMP := $(BUILD)/pydem.stamp
@@ -116,8 +127,10 @@ $(PYDEM_STAMP): $(BUILD)/libdem.a $(wildcard include/dem/*.h) pydem/_build_ffi.p
 	@rm -f pydem/_libdem.abi3.so  # the source-built copy of `pip install -e .`: one binding, make's
 	@touch $@
 
+# the 15 slowest tests are listed after every run, so a test that grows is seen
+PYTEST_ARGS ?=
 test-py: pydem
-	$(PYTHON) -m pytest -q tests/py
+	$(PYTHON) -m pytest -q --durations=15 $(PYTEST_ARGS) tests/py
 
 $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)

@@ -49,3 +49,13 @@ dem_status dem_effect_param_info(int index, int param, const char **name, const 
     if (neutral) *neutral = e->params[param].neutral;
     return DEM_OK;
 }
+
+dem_status dem_effect_param_range(int index, int param, double *min, double *max)
+{
+    const dem_effect_desc *e = dem_effect_get(index);
+    if (!e) return DEM_ERR_UNKNOWN_EFFECT;
+    if (param < 0 || param >= e->n_params) return DEM_ERR_INVALID_ARGUMENT;
+    if (min) *min = e->params[param].min;
+    if (max) *max = e->params[param].max;
+    return DEM_OK;
+}

@@ -24,13 +24,13 @@ def add_common(p, out: str, threads: int):
 def load_inputs(args, command: str, say):
     """(setup, observations, rows left out), or None after printing why not (exit status 2)."""
     from .calibration.quantities import ObservationError
-    from .calibration.setup import load_setup, observations_from_file
+    from .calibration.setup import load_setup, observations_of
     from .campaign import StoreError
     from .measurements import MeasurementError, load as load_measurements
     try:
-        load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
+        rows = load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
         setup = load_setup(args.stores, say, getattr(args, "retrain", False))
-        obs, skipped = observations_from_file(args.measurements, args.material, setup)
+        obs, skipped = observations_of(rows, setup, str(args.measurements), args.material)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
         print(f"pydem {command}: {exc}", file=sys.stderr)
         return None

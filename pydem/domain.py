@@ -20,7 +20,8 @@ COLOR_MODES = {"material": lib.DEM_COLOR_MATERIAL, "scalar": lib.DEM_COLOR_SCALA
 
 
 def effects() -> list[dict]:
-    """The effect registry: name, summary and parameters (name, unit, neutral value)."""
+    """The effect registry: name, summary and parameters (name, unit, neutral value, and the
+    closed range [min, max] libdem accepts)."""
     out = []
     for i in range(lib.dem_effect_count()):
         name, summary, n_params = ffi.new("const char **"), ffi.new("const char **"), ffi.new("int *")
@@ -28,8 +29,11 @@ def effects() -> list[dict]:
         params = []
         for p in range(n_params[0]):
             pn, unit, neutral = ffi.new("const char **"), ffi.new("const char **"), ffi.new("double *")
+            lo, hi = ffi.new("double *"), ffi.new("double *")
             check(lib.dem_effect_param_info(i, p, pn, unit, neutral))
-            params.append({"name": ffi.string(pn[0]).decode(), "unit": ffi.string(unit[0]).decode(), "neutral": neutral[0]})
+            check(lib.dem_effect_param_range(i, p, lo, hi))
+            params.append({"name": ffi.string(pn[0]).decode(), "unit": ffi.string(unit[0]).decode(), "neutral": neutral[0],
+                           "min": lo[0], "max": hi[0]})
         out.append({"name": ffi.string(name[0]).decode(), "summary": ffi.string(summary[0]).decode(), "params": params})
     return out
 

@@ -4,11 +4,11 @@
     glass_microbeads,ring_shear,mu_ie_s,0.45995,0.00867,,shear_fraction=0.5,calibrate,VSB ...
 
 test: ring_shear | aor | hopper | poured (bulk density of a poured fill: the AoR rig's filled
-cylinder); quantity: one of the test's (QUANTITIES_OF_TEST); unit: the quantity's SI unit (or
+cylinder); quantity: one of the test's (pydem.quantity_table.TABLE); unit: the quantity's SI unit (or
 empty for SI) or a known alternative (converted: g/cm^3, kPa, rad, g/s, ...), anything else is
 refused; a value outside the physically possible range is refused (1.55 "kg/m^3" is a
 g/cm^3 number);
-conditions: `key=value` pairs separated by `;` from CONDITION_NAMES; uncertainty: one standard
+conditions: `key=value` pairs separated by `;` from quantity_table.CONDITION_UNITS; uncertainty: one standard
 uncertainty, empty when not published; use: `calibrate` (screened against) or `compare` (shown
 in comparisons only). A UTF-8 byte-order mark and CRLF line ends (a spreadsheet's CSV) are
 accepted; duplicate rows and physically impossible values are refused. Errors name the file,
@@ -20,29 +20,10 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .quantity_table import CONDITION_UNITS, RIG_OF_TEST, TABLE
+
 COLUMNS = ["material", "test", "quantity", "value", "uncertainty", "unit", "conditions", "use", "source"]
 USES = ("calibrate", "compare")
-RIG_OF_TEST = {"ring_shear": "ring-shear", "aor": "aor", "hopper": "hopper", "poured": "aor"}  # poured: the AoR fill
-
-
-# per test, its quantities: (SI unit, {accepted unit: factor to SI}, physically possible range in SI)
-_COEF = ("", {"": 1.0, "-": 1.0, "1": 1.0}, (0.0, 5.0))
-_DENSITY = ("kg/m^3", {"kg/m^3": 1.0, "kg/m3": 1.0, "kg m-3": 1.0, "g/cm^3": 1000.0, "g/cm3": 1000.0,
-                       "g/ml": 1000.0, "t/m^3": 1000.0, "t/m3": 1000.0}, (10.0, 2.5e4))
-_STRESS = ("Pa", {"pa": 1.0, "kpa": 1000.0}, (0.0, 1e8))
-_ANGLE = ("deg", {"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees": 1.0, "rad": 57.29577951308232}, (0.0, 90.0))
-QUANTITIES_OF_TEST = {
-    "ring_shear": {"mu_ie_ps": _COEF, "mu_ie_s": _COEF, "bulk_density": _DENSITY, "tau_shear": _STRESS,
-                   "tau_preshear": _STRESS, "phi_e": _ANGLE, "phi_lin": _ANGLE, "phi_sf": _ANGLE, "sigma_1": _STRESS,
-                   "sigma_c": _STRESS, "yield_locus_intercept": _STRESS, "ffc": ("", {"": 1.0, "-": 1.0}, (0.0, 1e6))},
-    "aor": {"angle_of_repose": _ANGLE, "bulk_density": _DENSITY},
-    "poured": {"bulk_density": _DENSITY},
-    "hopper": {"mass_flow_rate": ("kg/s", {"kg/s": 1.0, "g/s": 1e-3, "t/h": 1.0 / 3.6}, (0.0, 1e6)),
-               "discharge_time": ("s", {"s": 1.0, "min": 60.0}, (0.0, 1e7)), "bulk_density": _DENSITY},
-}
-CONDITION_NAMES = ("preshear_stress", "shear_fraction", "slot_width", "size_cut_mm", "mean_diameter_mm")
-
-
 class MeasurementError(ValueError):
     """A malformed measurement file (the message names the line and the column)."""
 
@@ -119,12 +100,13 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
             if not rec[col]:
                 raise MeasurementError(f"{where(col)}: empty")
         test, quantity = rec["test"], rec["quantity"]
-        if test not in QUANTITIES_OF_TEST:
-            raise MeasurementError(f"{where('test')}: unknown test {test!r} (known: {', '.join(QUANTITIES_OF_TEST)})")
-        if quantity not in QUANTITIES_OF_TEST[test]:
+        if test not in TABLE:
+            raise MeasurementError(f"{where('test')}: unknown test {test!r} (known: {', '.join(TABLE)})")
+        if quantity not in TABLE[test]:
             raise MeasurementError(f"{where('quantity')}: test {test} has no quantity {quantity!r} "
-                                   f"(known: {', '.join(QUANTITIES_OF_TEST[test])})")
-        si_unit, units, (vmin, vmax) = QUANTITIES_OF_TEST[test][quantity]
+                                   f"(known: {', '.join(TABLE[test])})")
+        spec = TABLE[test][quantity]
+        si_unit, units, (vmin, vmax) = spec.unit, spec.units, spec.range
         unit_text = rec.get("unit", "").strip()
         factor = 1.0 if unit_text == "" else units.get(unit_text, units.get(unit_text.lower()))  # empty: SI
         if factor is None:
@@ -143,9 +125,9 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
             if "=" not in item:
                 raise MeasurementError(f"{where('conditions')}: expected key=value, got {item!r}")
             k, v = item.split("=", 1)
-            if k.strip() not in CONDITION_NAMES:
+            if k.strip() not in CONDITION_UNITS:
                 raise MeasurementError(f"{where('conditions')}: unknown condition {k.strip()!r} "
-                                       f"(known: {', '.join(CONDITION_NAMES)})")
+                                       f"(known: {', '.join(CONDITION_UNITS)})")
             conditions[k.strip()] = v.strip()
         if "shear_fraction" in conditions:
             f = _number(conditions["shear_fraction"], where("conditions") + " shear_fraction", False)

@@ -3,7 +3,7 @@
     python3 scripts/make_geometry.py
 
 open_box_40mm.stl: an open-topped box 40 x 40 x 60 mm (floor + four sides, two triangles a
-face), corner at the origin; used by the README's C example.
+face), corner at the origin; used by docs/libdem.md's C example.
 """
 from pathlib import Path
 

@@ -26,9 +26,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pydem.calibration import synthetic  # noqa: E402
+from pydem.calibration import confirm, synthetic  # noqa: E402
 from pydem.calibration.quantities import Observation, Quantity  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, load_setup  # noqa: E402
+from pydem.quantity_table import metric_spec  # noqa: E402
 
 
 
@@ -55,7 +56,7 @@ def run(args):
             truth = synthetic.Truth(truth.theta, kind, parameter, float(rng.uniform(lo, hi)))
             extra = {parameter: truth.strength}
         obs = synthetic.programme(setup.nets)
-        values = synthetic.rig_values(setup.stores, truth.inputs(setup.candidates), obs, seed=1000 + k, threads=1,
+        values = confirm.rig_values(setup.stores, truth.inputs(setup.candidates), obs, seed=1000 + k, threads=1,
                                       extra=extra)
         row = {"kind": kind, "truth": {"theta": truth.theta, "effect": truth.effect, "parameter": truth.parameter,
                                         "strength": truth.strength},
@@ -86,7 +87,7 @@ def rerun(args):
         idx = [i for i, r in enumerate(row["rows"]) if r["rig"] == rig]
         obs = [Observation(Quantity(rig, row["rows"][i]["metric"]), row["rows"][i]["conditions"], math.nan, math.nan,
                            row["rows"][i]["label"]) for i in idx]
-        values = synthetic.rig_values(stores, truth.inputs(registry()), obs, seed=1000 + k, threads=1)
+        values = confirm.rig_values(stores, truth.inputs(registry()), obs, seed=1000 + k, threads=1)
         for j, i in enumerate(idx):
             row["rows"][i]["value"] = values.get(j)
         row.setdefault("rerun", {})[rig] = stamp
@@ -131,7 +132,7 @@ def diagnose(args):
         if args.density_factor is not None:  # a discrepancy no candidate represents (synthetic.density_mismatch)
             noisy = synthetic.density_mismatch(noisy, args.density_factor)
             row = {**row, "rows": [{**r, "value": r["value"] * args.density_factor
-                                    if r["metric"] in synthetic.DENSITY_METRICS and r["value"] is not None
+                                    if metric_spec(r["metric"]).scales_with_density and r["value"] is not None
                                     else r["value"]} for r in row["rows"]]}
         d = run_diagnosis(f"dem set {k}", noisy, setup.nets, setup.ranges, setup.candidates, say=lambda *_: None)
         t = row["truth"]

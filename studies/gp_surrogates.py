@@ -17,7 +17,7 @@ from scipy import linalg, optimize
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from nn.mlp import Scaler, fold_of_rows  # noqa: E402
-from pydem.calibration.quantities import training_tables  # noqa: E402
+from pydem.calibration.store_data import training_tables  # noqa: E402
 from pydem.calibration.surrogates import FOLDS  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, load_setup, open_store_groups  # noqa: E402
 

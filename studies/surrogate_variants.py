@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT))
 
 from nn.mlp import cross_validate  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, open_store_groups  # noqa: E402
-from pydem.calibration.surrogates import training_tables  # noqa: E402
+from pydem.calibration.store_data import training_tables  # noqa: E402
 
 COHESION = "effects.cohesion_sjkr.cohesion_energy_density"
 

@@ -71,6 +71,9 @@ DEM_API dem_status dem_effect_info(int index, const char **name, const char **su
 /* Name, unit and neutral (switch-off) value of parameter p of effect i. */
 DEM_API dem_status dem_effect_param_info(int index, int param, const char **name, const char **unit,
                                          double *neutral);
+/* The values parameter p of effect i accepts: [min, max], closed (dem_pair_set_effect refuses
+ * any other), so a front-end can check a campaign's range before it runs anything. */
+DEM_API dem_status dem_effect_param_range(int index, int param, double *min, double *max);
 /* Switches an effect on for a material pair with the given parameters (all of them).
  * Setting every parameter to its neutral value switches it off. */
 DEM_API dem_status dem_pair_set_effect(dem_domain *domain, dem_material a, dem_material b,

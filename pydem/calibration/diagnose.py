@@ -198,10 +198,13 @@ def hypothetical_observations(observations: list[Observation], nets: dict) -> li
 
 
 def diagnose(material: str, observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate],
-             say=print) -> Diagnosis:
+             say=print, detection_limits: bool = True) -> Diagnosis:
     """The diagnosis of these rows; where it ends `unexplained`, the outlier screen asks whether one
-    row alone is to blame (outlier_screen) and, if so, the diagnosis without it, that row reported."""
-    d = _diagnose_rows(material, observations, nets, ranges, candidates, say)
+    row alone is to blame (outlier_screen) and, if so, the diagnosis without it, that row reported.
+    detection_limits=False leaves out the smallest detectable effects and the suggested next
+    measurement (`detectable`): nothing of the verdict depends on them, and they are about 40 % of
+    a diagnosis's time, which scoring thousands of verdicts (synthetic.validate) does not need."""
+    d = _diagnose_rows(material, observations, nets, ranges, candidates, say, detection_limits)
     if d.verdict != "unexplained" or not d.testable:
         return d
     out = outlier_screen(d, nets, ranges)
@@ -211,7 +214,7 @@ def diagnose(material: str, observations: list[Observation], nets: dict, ranges:
     say(f"  outlier: {info['label']} (deleting it lowers chi^2 by {info['delta_chi2']:.1f}, p = {info['p_value']:.2g} "
         f"over {len(observations)} rows); diagnosed again without it")
     rest = observations[:k] + observations[k + 1:]
-    again = _diagnose_rows(material, rest, nets, ranges, candidates, say)
+    again = _diagnose_rows(material, rest, nets, ranges, candidates, say, detection_limits)
     if again.verdict == "unexplained":
         return d
     again.outliers = [info]
@@ -265,7 +268,7 @@ def outlier_screen(d: Diagnosis, nets: dict, ranges: dict) -> tuple[int, dict] |
 
 
 def _diagnose_rows(material: str, observations: list[Observation], nets: dict, ranges: dict,
-                   candidates: list[Candidate], say=print) -> Diagnosis:
+                   candidates: list[Candidate], say=print, detection_limits: bool = True) -> Diagnosis:
     used = {o.quantity for o in observations}
     inputs = set().union(*(set(nets[q].input_names) for q in used))
     covered = [c for c in candidates if c.parameter in inputs and c.parameter in ranges]
@@ -308,7 +311,7 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
             f"estimate {res.estimate:.4g} {c.unit}")
     results.sort(key=lambda r: (-r.statistic, r.effect))
     detectable = {}
-    if covered_for_tests:
+    if covered_for_tests and detection_limits:
         detectable = detectable_effects(ref_model, ref, covered_for_tests, nets, ranges, covered, ALPHA)
         tests = candidate_tests(observations, nets)
         for c in covered_for_tests:

@@ -8,43 +8,14 @@ that the store does not vary itself (the shear fraction: one run measures severa
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..measurements import Measurement
+from ..quantity_table import CONDITION_UNITS, SURROGATE_CONDITIONS, per_fraction_metric, rig_quantities
 
-# conditions each rig's surrogates take as inputs, in SI units, and how measurement files name them
-CONDITIONS = {"ring-shear": ("preshear_stress", "shear_fraction"), "aor": (), "hopper": ("slot_width",)}
-CONDITION_UNITS = {"preshear_stress": "Pa", "shear_fraction": "", "slot_width": "m"}
-# quantities a measurement file may name, per rig, and the conditions each one depends on
-QUANTITIES = {
-    "ring-shear": {"mu_ie_ps": ("preshear_stress",), "mu_ie_s": ("preshear_stress", "shear_fraction"),
-                   "bulk_density": ("preshear_stress",)},
-    "aor": {"angle_of_repose": (), "bulk_density": ()},
-    "hopper": {"mass_flow_rate": ("slot_width",), "discharge_time": ("slot_width",), "bulk_density": ("slot_width",)},
-}
-_FRACTION_METRIC = re.compile(r"^mu_ie_s_(\d+)$")
-# A hopper run that did not empty (it jammed, or flowed too slowly for the time limit) measured no
-# discharge time, and no flow rate either: its 20-80 % slope mixes flow with an arch's standstill
-# (a run that jammed after 1.8 kg/s reports 0.3). Such runs are neither measurements (rig_values)
-# nor surrogate training rows or replicates (counted_runs): with them in, the default stores' flow-rate net
-# had a cross-validated R^2 of 0.965 (RMSE 0.139 kg/s) and predicted negative flows in 5 % of the
-# box; without, 0.982 (0.091 kg/s).
-DISCHARGE_METRICS = ("mass_flow_rate", "discharge_time")
-
-
-def counted_runs(store, column: str) -> np.ndarray:
-    """(runs,) bool: the store's finished runs whose value in metric column `column` counts as a
-    measurement: finite, and for a hopper's discharge metrics, from a hopper that emptied."""
-    j = store.metric_names.index(column)
-    ok = (store.status == 1) & np.isfinite(store.values[:, j])
-    if store.spec.rig == "hopper" and column in DISCHARGE_METRICS and "discharge_time" in store.metric_names:
-        ok &= np.isfinite(store.values[:, store.metric_names.index("discharge_time")])
-    return ok
-
-
+# the conditions each rig's surrogates take and the quantities they model (pydem.quantity_table)
+CONDITIONS = SURROGATE_CONDITIONS
+QUANTITIES = rig_quantities()
 @dataclass(frozen=True)
 class Quantity:
     rig: str
@@ -79,7 +50,7 @@ class Observation:
 def rig_metric(o: Observation) -> str:
     """The rig result's metric that measures the observation (mu_ie_s at fraction 0.6: mu_ie_s_60)."""
     if o.quantity.metric == "mu_ie_s":
-        return f"mu_ie_s_{round(100 * o.conditions['shear_fraction'])}"
+        return per_fraction_metric(o.conditions["shear_fraction"])
     return o.quantity.metric
 
 
@@ -115,70 +86,9 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
     return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed, ignored=ignored)
 
 
-def fraction_columns(metric_names: list[str]) -> list[tuple[int, float]]:
-    """(column, shear fraction) of each per-shear-point metric (mu_ie_s_40 -> 0.4) of a store."""
-    out = []
-    for j, name in enumerate(metric_names):
-        hit = _FRACTION_METRIC.match(name)
-        if hit:
-            out.append((j, int(hit.group(1)) / 100.0))
-    return out
-
-
 def test_conditions(o: Observation) -> tuple:
     """The conditions that make one test (one specimen, one run): all but the shear fraction,
     which is a point within a test."""
     return tuple(sorted((k, v) for k, v in o.conditions.items() if k != "shear_fraction"))
 
 
-def training_tables(store, pooled=()) -> dict[Quantity, tuple[list[str], np.ndarray, np.ndarray]]:
-    """{Quantity: (input names, inputs, values)} over the store's finished runs and those of the
-    stores pooled with it (pooled_runs.py: their runs mapped into this store's parameter
-    columns). Ring-shear runs give one mu_ie_s row per shear point, the fraction as an extra
-    input."""
-    from .pooled_runs import pooled_params
-    rig = store.spec.rig
-    names = list(store.spec.names)
-    sources = [(store, store.params)] + [(o, pooled_params(store, o)) for o in pooled]
-    out = {}
-    for metric in QUANTITIES[rig]:
-        q = Quantity(rig, metric)
-        xs, ys, fractions = [], [], set()
-        for st, params in sources:
-            if metric == "mu_ie_s":
-                for j, frac in fraction_columns(st.metric_names):
-                    ok = counted_runs(st, st.metric_names[j])
-                    xs.append(np.column_stack([params[ok], np.full(ok.sum(), frac)]))
-                    ys.append(st.values[ok, j])
-                    fractions.add(frac)
-            elif metric in st.metric_names:
-                j = st.metric_names.index(metric)
-                ok = counted_runs(st, metric)
-                xs.append(params[ok])
-                ys.append(st.values[ok, j])
-        if not xs:
-            continue
-        if metric != "mu_ie_s":
-            out[q] = (names, np.vstack(xs), np.concatenate(ys))
-        elif len(fractions) > 1:
-            out[q] = (names + ["shear_fraction"], np.vstack(xs), np.concatenate(ys))
-        else:  # one shear point: the fraction is a fixed condition of the store, not an input
-            out[q] = (names, np.vstack(xs)[:, :-1], np.concatenate(ys))
-    return out
-
-
-def preset_conditions(store) -> dict[str, float]:
-    """The conditions the store's runs have when they do not vary them (its preset with the
-    campaign's fixed settings): the defaults for rows that do not give them."""
-    cfg = store.spec.config({})
-    out = {}
-    for cname in CONDITIONS[store.spec.rig]:
-        if cname == "shear_fraction":
-            points = getattr(cfg, "shear_points", None) or []
-            if len(points) == 1:  # a single shear point is the store's fixed fraction
-                out[cname] = float(points[0])
-            continue
-        v = getattr(cfg, cname, None)
-        if v is not None:
-            out[cname] = float(v)
-    return out

@@ -12,8 +12,9 @@ from ..campaign.store import check_same_physics
 from ..measurements import load as load_measurements
 from .candidates import BASE_PARAMETERS, Candidate, registry
 from .pooled_runs import check_poolable
-from .quantities import Observation, ObservationError, observation, preset_conditions
-from .surrogates import attach_run_correlations, load_or_train, replicate_stores
+from .quantities import Observation, ObservationError, observation
+from .store_data import preset_conditions, replicate_stores
+from .surrogates import attach_run_correlations, load_or_train
 
 # the shipped diagnosis stores, one per rig (and stores pooled into one, open_store_groups): at the
 # rigs' tiny presets (the CI's, quick to remake) and at their default presets (the ones
@@ -113,8 +114,14 @@ def load_setup(paths, say=print, retrain: bool = False) -> Setup:
 
 
 def observations_from_file(path: str | Path, material: str, setup: Setup) -> tuple[list[Observation], list[str]]:
-    """(usable observations, one line per row left out and why)."""
-    rows = [m for m in load_measurements(path, material) if m.use == "calibrate"]
+    """(usable observations, one line per row left out and why) of a measurement file."""
+    return observations_of(load_measurements(path, material), setup, str(path), material)
+
+
+def observations_of(measurements: list, setup: Setup, source: str, material: str) -> tuple[list[Observation], list[str]]:
+    """(usable observations, one line per row left out and why) of a material's measurement rows
+    (measurements.load), read from `source`."""
+    rows = [m for m in measurements if m.use == "calibrate"]
     out, skipped = [], []
     for m in rows:
         try:
@@ -143,6 +150,6 @@ def observations_from_file(path: str | Path, material: str, setup: Setup) -> tup
         out.append(o)
     if not out:
         offered = ", ".join(sorted(q.key for q in setup.nets))
-        raise ObservationError(f"{path}: no row of {material!r} can be compared with the campaigns "
+        raise ObservationError(f"{source}: no row of {material!r} can be compared with the campaigns "
                                f"(they offer {offered}); " + "; ".join(skipped))
     return out, skipped

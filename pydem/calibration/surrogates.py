@@ -32,7 +32,9 @@ import numpy as np
 
 from nn.export import NetArrays, arrays_of
 
-from .quantities import Quantity, counted_runs, fraction_columns, training_tables
+from .quantities import Quantity
+from .store_data import (fraction_columns, metric_columns, replicate_deviations, replicate_groups,
+                         replicate_store_paths, replicate_stores, seed_scatter, training_tables)
 
 NET_FORMAT = 3  # 3: bagged nets with an error model, log target where it fits better (older caches are retrained)
 SIZES = (3, 6, 10, 16)  # hidden units per bagged member, chosen by the cross-validated RMSE
@@ -183,64 +185,6 @@ def fit_error_model(net: QuantityNet, x: np.ndarray, residuals: np.ndarray, prio
     net.err_c0, net.err_c = float(res.x[0]), res.x[1:].copy()
 
 
-def replicate_store_paths(store, pooled=()) -> list[Path]:
-    """Where a store's seed-scatter companions live: <name>_replicates.h5 next to it and next to
-    each store pooled with it (same rig and preset), those that exist. Several: replicates over
-    the whole box and on the one-effect axes, where the base model's scatter is (the box's
-    replicate points are nearly all cohesive)."""
-    paths = [st.path.with_name(st.path.stem + "_replicates.h5") for st in (store, *pooled)]
-    return [p for p in paths if p.exists()]
-
-
-def seed_scatter(reps) -> dict[Quantity, float]:
-    """Pooled seed-to-seed standard deviation of one run per quantity, from replicate stores
-    (the shear points of one quantity pooled together)."""
-    from .quantities import QUANTITIES
-    acc: dict[Quantity, list] = {}
-    for store in reps:
-        rig = store.spec.rig
-        for metric in QUANTITIES[rig]:
-            names = [metric] if metric in store.metric_names else []
-            if metric == "mu_ie_s":
-                names += [store.metric_names[j] for j, _ in fraction_columns(store.metric_names)]
-            a = acc.setdefault(Quantity(rig, metric), [0.0, 0])
-            for m in names:
-                _, _, counts, sd = store.point_table(m, rows=counted_runs(store, m))
-                k = int((counts - 1).sum())
-                if k > 0 and np.isfinite(sd):
-                    a[0], a[1] = a[0] + sd * sd * k, a[1] + k
-    return {q: float(np.sqrt(ss / dof)) for q, (ss, dof) in acc.items() if dof > 0}
-
-
-def replicate_groups(store, reps, net: QuantityNet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(sd, dof, inputs) of every replicated point of the replicate stores `reps` (each shear
-    point its own group) for the net's quantity: the runs' sample sd at the point, its degrees of
-    freedom (runs - 1), and the point's inputs in the net's columns (each replicate store's
-    parameters mapped into `store`'s, as pooling does, plus the shear fraction)."""
-    from .pooled_runs import pooled_params
-    q = net.quantity
-    sd, dof, xs = [], [], []
-    for rep in reps:
-        params = pooled_params(store, rep)
-        if q.metric == "mu_ie_s":
-            cols = list(fraction_columns(rep.metric_names))
-        else:
-            cols = [(rep.metric_names.index(q.metric), None)] if q.metric in rep.metric_names else []
-        for j, frac in cols:
-            counted = counted_runs(rep, rep.metric_names[j])
-            for p in np.unique(rep.points):
-                k = (rep.points == p) & counted
-                if k.sum() < 2:
-                    continue
-                x = params[k][0] if frac is None or "shear_fraction" not in net.input_names else np.r_[params[k][0], frac]
-                if len(x) != len(net.input_names):
-                    continue
-                sd.append(rep.values[k, j].std(ddof=1))
-                dof.append(k.sum() - 1)
-                xs.append(x)
-    return np.array(sd), np.array(dof, dtype=float), np.array(xs).reshape(len(xs), len(net.input_names))
-
-
 def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.ndarray) -> float:
     """The seed scatter's shape over the campaign box, from the replicated points: one pooled sd
     everywhere, or a fixed fraction r of the error model's total sd at each point (a rig scatters
@@ -262,26 +206,6 @@ def fit_scatter_ratio(net: QuantityNet, sd: np.ndarray, dof: np.ndarray, x: np.n
     if pooled <= 0 or loglik(r2 * t * t) <= loglik(np.full(len(v), pooled)):
         return float("nan")
     return float(np.sqrt(r2))
-
-
-def replicate_deviations(reps, columns: list[str]) -> list[np.ndarray]:
-    """Per replicated point of the stores `reps` that measure every metric column in `columns`:
-    its runs' deviations from the point's mean, each column in units of its sd at the point
-    ((runs, columns); runs counted for every column, at least 3, every sd positive)."""
-    dev = []
-    for rep in reps:
-        if not all(c in rep.metric_names for c in columns):
-            continue
-        idx = [rep.metric_names.index(c) for c in columns]
-        ok = np.all([counted_runs(rep, c) for c in columns], axis=0)
-        for p in np.unique(rep.points):
-            v = rep.values[(rep.points == p) & ok][:, idx]
-            if len(v) < 3:
-                continue
-            sd = v.std(axis=0, ddof=1)
-            if np.all(sd > 0):
-                dev.append((v - v.mean(axis=0)) / sd)
-    return dev
 
 
 def test_correlation(store, net: QuantityNet, reps=()) -> float:
@@ -310,25 +234,18 @@ def test_correlation(store, net: QuantityNet, reps=()) -> float:
     return float(np.clip(c[np.triu_indices(len(points), 1)].mean(), 0.0, 0.95))
 
 
-def _metric_columns(metric: str, metric_names: list[str]) -> list[str]:
-    """The store columns of a quantity's metric: itself, or mu_ie_s's shear-point columns."""
-    if metric == "mu_ie_s":
-        return [metric_names[j] for j, _ in fraction_columns(metric_names)]
-    return [metric] if metric in metric_names else []
-
-
 def run_correlations(reps, metrics: list[str]) -> dict[tuple[str, str], float]:
     """{(a, b): rho} for every pair of different metrics that one run of the rig measures: the
     correlation of the runs' seed deviations (replicate_deviations, pooled over the stores'
     points; for mu_ie_s the mean over its shear points), where at least 5 points with 3 or more
-    runs measure both; else absent (0). Measured on the default stores (2026-11-28): a hopper
+    runs measure both; else absent (0). On the shipped default stores: a hopper
     run's flow rate and discharge time -0.5 / -0.74 (whole box / one-effect axes), a ring-shear
     run's mu_ie_ps and bulk density 0.41 / 0.16 (same point, same packing)."""
     out = {}
     names = reps[0].metric_names if reps else []
     for i, a in enumerate(metrics):
         for b in metrics[i + 1:]:
-            ca, cb = _metric_columns(a, names), _metric_columns(b, names)
+            ca, cb = metric_columns(a, names), metric_columns(b, names)
             if not ca or not cb:
                 continue
             dev = replicate_deviations(reps, ca + cb)
@@ -403,8 +320,8 @@ def _mark_used(stamp: Path):
 
 
 def _prune_slots(d: Path, keep: Path):
-    """The SLOTS most recently used training sets stay; older ones and the flat layout that kept
-    one set per store (until 2026-11-24) go."""
+    """The SLOTS most recently used training sets stay; older ones and the older flat layout that kept
+    one set per store go."""
     for old in list(d.glob("*.npz")) + [d / "store_hash.txt"]:
         old.unlink(missing_ok=True)
     slots = sorted((p for p in d.iterdir() if p.is_dir() and (p / "store_hash.txt").exists()),
@@ -447,12 +364,6 @@ def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
             f"; {time.perf_counter() - t0:.0f} s); error model: sd {np.percentile(sd, 10):.3g}-{np.percentile(sd, 90):.3g} "
             f"(10-90 % of the runs)")
     return nets
-
-
-def replicate_stores(store, pooled=()) -> list:
-    """The store's replicate stores, opened (replicate_store_paths)."""
-    from ..campaign import Campaign
-    return [Campaign.open(p).store for p in replicate_store_paths(store, pooled)]
 
 
 def replicate_shape(store, reps, net: QuantityNet) -> tuple[float, float]:

@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..quantity_table import metric_spec
 from .candidates import BASE_PARAMETERS, Candidate
-from .quantities import DISCHARGE_METRICS, Observation, Quantity, rig_metric, test_conditions
+from .confirm import rig_values
+from .quantities import Observation, Quantity, test_conditions
 
-NOISE = {"mu_ie_ps": ("rel", 0.02), "mu_ie_s": ("rel", 0.02), "bulk_density": ("rel", 0.01),
-         "angle_of_repose": ("abs", 0.5), "mass_flow_rate": ("rel", 0.02), "discharge_time": ("rel", 0.02)}
 
 
 def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6, 0.8), slots=None) -> list[Observation]:
@@ -54,7 +54,7 @@ def programme(nets: dict, preshear=(1000.0, 2000.0, 5000.0), fractions=(0.4, 0.6
 
 
 def noise_sd(metric: str, value: float) -> float:
-    kind, v = NOISE[metric]
+    kind, v = metric_spec(metric).noise
     return v * abs(value) if kind == "rel" else v
 
 
@@ -81,7 +81,7 @@ def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidat
     drawn vanishingly small. A two-sided candidate's side is drawn in proportion to the room on
     it (size spread: 0.4 above the neutral 0.1, 0.1 below), so the strength is near-uniform over
     the campaign range, as a material's would be (an even coin gave half of the size-spread sets
-    a spread of 0-0.1: the three DEM sets of 2026-11-24 all landed there)."""
+    a spread of 0-0.1, below what any rig can see)."""
     theta = {n: float(rng.uniform(*ranges[n])) for n in BASE_PARAMETERS}
     if effect is None:
         return Truth(theta, None, None, None)
@@ -212,51 +212,6 @@ def signal(setup, truth: Truth, obs: list[Observation]) -> float:
     return float(fit.chi2)
 
 
-def rig_values(stores: dict, inputs: dict[str, float], obs: list[Observation], seed: int, threads: int = 1,
-               say=print, progress=None, extra: dict | None = None) -> dict[int, float]:
-    """One rig run per condition group of `obs` at the stores' presets with the given parameter
-    values (a ring-shear run measures its pre-shear and every shear point): {observation index:
-    value}. An observation whose run failed is missing from the result. `extra`: settings no
-    store varies, given to every run (an effect that is not a candidate)."""
-    from ..rigs import RIGS
-    import time
-    groups: dict = {}
-    for i, o in enumerate(obs):
-        key = (o.quantity.rig, test_conditions(o))
-        groups.setdefault(key, []).append(i)
-    values = {}
-    for g, ((rig, cond), idx) in enumerate(groups.items()):
-        store = stores[rig]
-        point = {k: inputs[k] for k in store.spec.names if k in inputs}
-        point.update({k: v for k, v in cond})
-        point.update(extra or {})
-        cfg = store.spec.config(point)
-        fractions = sorted({obs[i].conditions["shear_fraction"] for i in idx if "shear_fraction" in obs[i].conditions})
-        if fractions:
-            cfg.shear_points = list(fractions)
-        cfg.num_threads = threads
-        t0 = time.perf_counter()
-        try:
-            res = RIGS[rig][0](cfg).run(seed=seed, progress=progress)
-        except Exception as exc:  # a run that fails is reported, the others go on
-            say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)} failed: {exc}")
-            continue
-        if progress is not None:
-            progress.done()
-        say(f"    [{g + 1}/{len(groups)}] DEM {rig} {dict(cond)}: {time.perf_counter() - t0:.0f} s")
-        dt = res.metrics.get("discharge_time")
-        jammed = rig == "hopper" and not (dt is not None and math.isfinite(dt.value))
-        for i in idx:
-            o = obs[i]
-            metric = rig_metric(o)
-            if jammed and metric in DISCHARGE_METRICS:
-                continue  # a hopper that did not empty measured neither a flow rate nor a discharge time
-            v = res.metrics[metric].value if metric in res.metrics else None
-            if isinstance(v, float) and math.isfinite(v) and v > 0:
-                values[i] = v
-    return values
-
-
 def dem_set(stores: dict, nets: dict, candidates: list[Candidate], truth: Truth, rng: np.random.Generator,
             obs: list[Observation], seed: int, threads: int = 1, say=print) -> list[Observation]:
     """Pseudo-measurements from rig runs at the stores' presets, then lab noise; rows whose run
@@ -294,7 +249,6 @@ def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str)
     Path(path).write_text("\n".join(lines) + "\n")
 
 
-DENSITY_METRICS = ("bulk_density", "mass_flow_rate")  # the quantities that scale with the solid density
 
 
 def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]:
@@ -302,7 +256,7 @@ def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]
     model assumes, which scales every bulk density and mass flow rate and nothing else."""
     out = []
     for o in obs:
-        k = factor if o.quantity.metric in DENSITY_METRICS else 1.0
+        k = factor if metric_spec(o.quantity.metric).scales_with_density else 1.0
         out.append(Observation(o.quantity, dict(o.conditions), o.value * k, o.uncertainty * k, o.label))
     return out
 
@@ -404,7 +358,8 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
             if kind == "unexplained":
                 obs = density_mismatch(obs, 1.25)
             visible = signal(setup, truth, obs) if source == "surrogate" else None
-            d = diagnose(f"{kind}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None)
+            d = diagnose(f"{kind}-{k}", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None,
+                         detection_limits=False)
             s_before, s_after = d.summary_of(d.base, d.base_model), d.summary_of(d.after, d.after_model)
             truth_error = {"before": None, "after": None}
             if source == "surrogate" and kind != "unexplained":

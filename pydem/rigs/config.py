@@ -123,7 +123,11 @@ def set_value(cfg, key: str, value: Any):
     `effects.<effect>.<parameter>`) from a string or a value, then checks its range."""
     kind, where, what = _locate(cfg, key)
     if kind == "effect":
-        cfg.params.effects.setdefault(where, {})[what["name"]] = _coerce(value, 0.0, key)
+        v = _coerce(value, 0.0, key)
+        if not what["min"] <= v <= what["max"]:  # libdem's own range (dem_effect_param_range), checked before any run
+            unit = f" {what['unit']}" if what["unit"] else ""
+            raise ConfigError(f"{key} = {v:g}{unit} is outside libdem's range [{what['min']:g}, {what['max']:g}]{unit}")
+        cfg.params.effects.setdefault(where, {})[what["name"]] = v
         return
     target, name = where, what
     setattr(target, name, _coerce(value, getattr(target, name), key))

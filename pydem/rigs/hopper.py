@@ -52,7 +52,7 @@ class HopperConfig:
     settle_time: float = knob(0.4, 0.0, 60.0, "s", "settling after the last filling batch")
     density_boxes: str = knob("below_highest", doc="where the bulk density is measured: three boxes ending two "
                               "diameters below the highest sphere (the tiny preset's), or below the free surface's "
-                              "lowest point (the default preset's since 2026-11-27: a sloped surface leaves the "
+                              "lowest point (the default preset's: a sloped surface leaves the "
                               "former's top box part empty, seed scatter 43 -> 14 kg/m^3, studies/hopper_bulk_density.py)",
                               choices=("below_highest", "below_surface"))
     max_time: float = knob(30.0, 0.1, 3600.0, "s", "discharge time limit")
@@ -365,7 +365,7 @@ class Hopper:
         return p.density * float(fr.mean()), p.density * float(sem)
 
     def _boxes_below_highest(self, d, h_wedge: float) -> list[tuple]:
-        """The tiny preset's (and the default's before 2026-11-27): three boxes from the wedge's top
+        """The tiny preset's: three boxes from the wedge's top
         (or 0.3 of the bed) to two diameters below the highest sphere, as wide as the vertical
         section less a diameter."""
         c = self.config

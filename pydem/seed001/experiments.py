@@ -307,7 +307,7 @@ def gauge_rows(case: str, gauges: dict, data: dict, folds: list[str], k: int) ->
     beyond least squares, per packing: `fill_level`, a cubic of the grey fill fraction
     (baselines.fill_level_nrrp); `species`, the count from each species' fill, quadratic in each
     (baselines.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
-    per packing erred least on the 1 ms frame set, 2026-11-28). Their scores and readings."""
+    per packing erred least on the 1 ms frame set). Their scores and readings."""
     same = [c for c in gauges if packing_of(c) == packing_of(case) and fold_of(c) in pretraining_folds(fold_of(case), folds)]
     row = gauge_readings(case, same, gauges, {c: data[c].nrrp for c in same + [case]}, k) if same else {}
     truth = data[case].nrrp[k:]

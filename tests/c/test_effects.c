@@ -43,6 +43,38 @@ static void test_registry(void **st)
     assert_int_equal(dem_effect_info(dem_effect_count(), NULL, NULL, NULL), DEM_ERR_UNKNOWN_EFFECT);
 }
 
+/* Every parameter's published range holds its neutral value, and dem_pair_set_effect accepts
+ * exactly that closed range: both ends pass, the next double outside each end is refused. */
+static void test_param_range_is_what_pair_set_effect_accepts(void **st)
+{
+    (void)st;
+    dem_material mat;
+    dem_domain *d = make_domain(0.01, 1e-6, E, 0.5, 0.5, &mat);
+    for (int i = 0; i < dem_effect_count(); i++) {
+        const char *name;
+        int np;
+        assert_ok(dem_effect_info(i, &name, NULL, &np));
+        for (int p = 0; p < np; p++) {
+            double lo, hi, neutral, v[8];
+            assert_true(np <= 8);
+            assert_ok(dem_effect_param_range(i, p, &lo, &hi));
+            assert_ok(dem_effect_param_info(i, p, NULL, NULL, &neutral));
+            assert_true(lo <= neutral && neutral <= hi && lo < hi);
+            for (int k = 0; k < np; k++) assert_ok(dem_effect_param_info(i, k, NULL, NULL, &v[k]));
+            const double inside[2] = {lo, hi}, outside[2] = {nextafter(lo, -INFINITY), nextafter(hi, INFINITY)};
+            for (int s = 0; s < 2; s++) {
+                v[p] = inside[s];
+                assert_ok(dem_pair_set_effect(d, mat, mat, name, v, np));
+                v[p] = outside[s];
+                assert_int_equal(dem_pair_set_effect(d, mat, mat, name, v, np), DEM_ERR_INVALID_ARGUMENT);
+            }
+        }
+    }
+    assert_int_equal(dem_effect_param_range(dem_effect_count(), 0, NULL, NULL), DEM_ERR_UNKNOWN_EFFECT);
+    assert_int_equal(dem_effect_param_range(0, -1, NULL, NULL), DEM_ERR_INVALID_ARGUMENT);
+    dem_domain_destroy(d);
+}
+
 static double pair_force_z(double kc, double delta)
 {
     dem_material mat;
@@ -351,6 +383,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_registry),
+        cmocka_unit_test(test_param_range_is_what_pair_set_effect_accepts),
         cmocka_unit_test(test_sjkr_pair),
         cmocka_unit_test(test_sjkr_wall_and_switch_off),
         cmocka_unit_test(test_sjkr_collision_loses_energy),

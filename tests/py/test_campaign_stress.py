@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from pydem.campaign import Campaign, CampaignStore, StoreError
 from pydem.campaign.store import DONE
@@ -46,6 +47,7 @@ def start_campaign(toml, store):
                              "--workers", "2"], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 
+@pytest.mark.slow
 def test_kills_and_polling_lose_nothing(tmp_path):
     rng = random.Random(11)
     toml = write_toml(tmp_path / "c.toml", samples=10)

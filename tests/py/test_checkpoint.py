@@ -23,6 +23,7 @@ def assert_same_run(res, whole):
         assert np.array_equal(res.series[k], whole.series[k]), k
 
 
+@pytest.mark.slow
 def test_split_ring_shear_is_bitwise_the_whole_run(tmp_path):
     whole = tiny("ring-shear").run(seed=4)
     rig = tiny("ring-shear")

@@ -53,6 +53,7 @@ def blobs(n: int, size: int = 64, seed: int = 0):
     return x, (side.astype(np.float32) / size) ** 2
 
 
+@pytest.mark.slow
 def test_training_lowers_the_loss_and_resumes_bitwise(tmp_path):
     torch.set_num_threads(1)
     x, y = blobs(160)

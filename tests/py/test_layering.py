@@ -117,6 +117,14 @@ def test_no_private_name_taken_from_another_module():
     assert not private, "\n".join(private)
 
 
+def test_the_commands_do_not_reach_into_the_validation_harness():
+    """pydem.calibration.synthetic makes and scores hidden-effect sets for the studies; no module
+    of the package (the commands, --confirm included) depends on it."""
+    edges, _ = graph()
+    users = sorted(m for m, ws in edges.items() if "pydem.calibration.synthetic" in ws)
+    assert not users, f"modules that import the validation harness: {users}"
+
+
 def test_the_checks_see_a_circle_and_a_leaf_broken():
     """The checks themselves: a made-up graph with a circle is caught, a tree is not."""
     assert circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]

@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 SCRIPT = r"""
@@ -42,6 +44,7 @@ print("done")
 """
 
 
+@pytest.mark.slow
 def test_no_leaks_or_invalid_access_under_valgrind(tmp_path):
     valgrind = shutil.which("valgrind")
     assert valgrind, "valgrind is missing: run scripts/setup.sh"

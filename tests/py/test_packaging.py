@@ -25,6 +25,13 @@ def test_one_version_in_pyproject_package_and_headers():
     assert not any(d.startswith("torch") for d in project["dependencies"]), "torch must stay an extra"
 
 
+def test_the_wheel_lists_every_python_package():
+    """A package folder missing from pyproject's list would be left out of `pip install .`."""
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(ROOT).parts) for top in ("pydem", "nn") for p in (ROOT / top).rglob("__init__.py")}
+    assert found == listed
+
+
 def test_pydem_version_command():
     out = subprocess.run([sys.executable, "-m", "pydem", "--version"], capture_output=True, text=True, check=True).stdout
     assert out.strip() == f"pydem {pydem.__version__} (libdem {pydem.LIBDEM_VERSION})"
@@ -56,10 +63,10 @@ def test_install_is_portable_versioned_and_links(tmp_path):
         dyn = subprocess.run(["readelf", "-d", str(lib / f"libdem.so.{version}")], capture_output=True, text=True).stdout
         assert f"Library soname: [{soname}]" in dyn
         assert "RPATH" not in dyn and "RUNPATH" not in dyn
-    # the README's C example against the installed headers and library, through dem.pc
+    # docs/libdem.md's C example against the installed headers and library, through dem.pc
     example = tmp_path / "example.c"
-    readme = (ROOT / "README.md").read_text()
-    example.write_text(re.search(r"```c readme-example\n(.*?)```", readme, re.S).group(1))
+    doc = (ROOT / "docs/libdem.md").read_text()
+    example.write_text(re.search(r"```c libdem-example\n(.*?)```", doc, re.S).group(1))
     pc = (lib / "pkgconfig/dem.pc").read_text().replace("prefix=/opt/dem", f"prefix={dest}/opt/dem")
     (tmp_path / "pc").mkdir()
     (tmp_path / "pc/dem.pc").write_text(pc)
@@ -75,6 +82,7 @@ def test_install_is_portable_versioned_and_links(tmp_path):
     assert f"{soname} => {lib}" in ldd
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not shutil.which("gcc"), reason="needs a C compiler")
 def test_wheel_builds_libdem_from_sources_and_runs_outside_the_checkout(tmp_path):
     wheels = tmp_path / "wheels"

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from pydem.calibration.pooled_runs import PoolError, check_poolable, pooled_params
-from pydem.calibration.quantities import Quantity, training_tables
+from pydem.calibration.quantities import Quantity
+from pydem.calibration.store_data import training_tables
 from pydem.campaign.runner import resolved_config
 from pydem.campaign.spec import CampaignSpec
 
@@ -76,7 +77,7 @@ def test_a_different_blow_up_limit_does_not_block_pooling():
 def test_a_hopper_that_did_not_empty_trains_no_discharge_metric():
     """A run that jammed measured no discharge time and no flow rate (its 20-80 % slope mixes flow
     and standstill): neither surrogate learns from it, as no pseudo-measurement contains it
-    (synthetic.rig_values); its bulk density, measured before the gate opened, still counts."""
+    (confirm.rig_values); its bulk density, measured before the gate opened, still counts."""
     ranges = {"friction": (0.05, 1.0), "slot_width": (0.03, 0.08)}
     main = store("hopper.h5", ranges, [[0.3, 0.05], [0.9, 0.04]], [[1.2, 1.1, 1300.0], [np.nan, 0.3, 1250.0]],
                  preset="default", rig="hopper")

@@ -147,7 +147,7 @@ def test_bulk_density_below_the_free_surface_ignores_a_slope_and_a_stray_sphere(
     8 % (three boxes of ~160 centres each; stratified counts vary by a few boundary cells, ~3 %),
     on ten beds (the default preset's measure). The tiny preset's boxes (`below_highest`, ending
     below the highest sphere) reach into the empty space above the slope and read more than 30 %
-    low — the hopper's low outliers before 2026-11-27."""
+    low on a sloped surface."""
     surface = lambda x: 0.17 + 0.2 * x  # noqa: E731
     for k in range(10):
         rig = Hopper(load(HopperConfig, "default"))
@@ -164,6 +164,7 @@ def test_bulk_density_below_the_free_surface_ignores_a_slope_and_a_stray_sphere(
         assert rho_old < 0.7 * 1000.0 * phi
 
 
+@pytest.mark.slow
 def test_the_fill_keeps_the_largest_spheres_clear_of_the_back_wall():
     """A lattice row 0.49 spacing from the back wall, jittered 2 % towards it, puts a sphere of the
     largest size 0.0065 of its diameter into the wall: run 238 of the shipped size-spread store

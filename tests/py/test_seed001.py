@@ -48,6 +48,7 @@ def test_pydem_images_is_the_seed001_command_line():
     assert r.returncode == 0 and r.stdout.startswith("| parameter | A | B1 |"), r.stderr
 
 
+@pytest.mark.slow
 def test_experiments_and_report_run_on_the_subset(tmp_path):
     import torch
     from pydem.seed001 import experiments as ex
