@@ -13,6 +13,7 @@ import numpy as np
 from ._libdem import ffi, lib
 from .cdata import as_c_array, c_definition, c_pointer
 from .errors import DemInvalidArgument, DemUnknownError, check
+from .walls import MeshWall, PlaneWall
 
 ROLLING_MODELS = {"cdt": lib.DEM_ROLLING_CDT, "epsd": lib.DEM_ROLLING_EPSD, "epsd2": lib.DEM_ROLLING_EPSD2}
 REGIONS = {"box": lib.DEM_REGION_BOX, "cylinder": lib.DEM_REGION_CYLINDER, "annular_sector": lib.DEM_REGION_ANNULAR_SECTOR}
@@ -289,13 +290,11 @@ class Domain:
                        material: int | None = None, velocity: Sequence[float] | None = None):
         """A plane wall (None: libdem's default, dem_default_plane_wall_def: the floor z >= 0,
         material 0, at rest)."""
-        from .walls import PlaneWall
         return PlaneWall._create(self, axis, side, position, material, velocity)
 
     def add_mesh_wall(self, source, material: int = 0, scale: float = 1.0, offset: Sequence[float] = (0.0, 0.0, 0.0),
                       weld_tolerance: float = 0.0):
         """A triangle-mesh wall from an STL path or a (vertices (nv, 3), triangles (nt, 3)) pair."""
-        from .walls import MeshWall
         return MeshWall._create(self, source, material, scale, offset, weld_tolerance)
 
     # ---- contacts -----------------------------------------------------------------------------

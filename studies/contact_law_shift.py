@@ -29,7 +29,6 @@ def done() -> set:
 
 def run(root: Path, label: str):
     sys.path.insert(0, str(root))
-    import numpy as np
     import pydem
     from pydem.campaign import Campaign
     from pydem.rigs import RIGS, load

@@ -11,7 +11,6 @@ rarely.
 Writes studies/results/diagnosis_detectability_<preset>.json and prints the table."""
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -20,10 +19,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import effect_set_args  # noqa: E402
 import results_json  # noqa: E402
 from pydem.calibration import synthetic  # noqa: E402
 from pydem.calibration.diagnose import diagnose  # noqa: E402
-from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
 
 
 def beyond(strength: float, info: dict) -> bool:
@@ -34,12 +33,7 @@ def beyond(strength: float, info: dict) -> bool:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--preset", default="default")
-    ap.add_argument("--sets", type=int, default=30)
-    ap.add_argument("--seed", type=int, default=1)
-    args = ap.parse_args()
-    setup = load_setup([s for s in (ROOT / p for p in shipped_stores(args.preset)) if s.exists()], say=lambda *a: None)
+    args, setup = effect_set_args.parse_and_load(__doc__)
     t0 = time.perf_counter()
     rows = []
     for c, k, truth, obs in synthetic.effect_sets(setup, args.sets, args.seed):

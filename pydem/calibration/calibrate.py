@@ -17,7 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from nn.export import weights_text
+
 from ..campaign.design import design_points
+from ..mlp import NativeMLP
 from .candidates import Candidate
 from .fit import Fit, Model, minimise, posterior
 from .quantities import Observation
@@ -117,8 +120,6 @@ def window_screen(model: Model, window: float = 0.05, samples: int = 2 ** 20, th
     parameters' box; a point is admissible when every observation's net, at that point and the
     observation's conditions, predicts the measured value within ±window (relative). Each net
     is libdem's MLP (dem_mlp_eval_many, `threads` threads) built in memory from the surrogate."""
-    from nn.export import weights_text
-    from ..mlp import NativeMLP
     ranges = {n: (lo, hi) for n, lo, hi in zip(model.free, model.lo, model.hi)}
     pts = design_points("sobol", ranges, 0, samples, seed)
     t0 = time.perf_counter()

@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+from ..domain import effects
+
 BASE_PARAMETERS = ("friction", "rolling_friction", "restitution")
 
 
@@ -37,7 +39,6 @@ def _const(v):
 
 def registry() -> list[Candidate]:
     """Every candidate: the rig-level ones and every parameter of every libdem effect."""
-    from ..domain import effects
     out = [
         Candidate("wall_friction", "wall_friction", "", lambda th: th["friction"], "+-",
                   "walls have the particles' sliding friction (one friction coefficient)"),

@@ -26,6 +26,7 @@ from scipy import optimize, stats
 
 from .candidates import Candidate
 from .fit import Fit, Model, minimise
+from .quantities import CONDITION_UNITS, CONDITIONS, Observation
 
 POWER = 0.9
 SCAN = 8  # scan points per side, from the neutral value to the range's edge
@@ -92,7 +93,6 @@ def candidate_tests(observations: list, nets: dict, points: int = 4) -> list[tup
     its test condition over the campaign range (log-spaced for the pre-shear stress), giving every
     quantity the rig measures (the shear points at the fractions observed, else 40/60/80 %).
     [(label, rows)]."""
-    from .quantities import CONDITION_UNITS, CONDITIONS, Observation
     fractions = sorted({o.conditions["shear_fraction"] for o in observations if "shear_fraction" in o.conditions}) \
         or [0.4, 0.6, 0.8]
     tests = []

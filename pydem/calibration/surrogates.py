@@ -32,7 +32,8 @@ import numpy as np
 
 from nn.export import NetArrays, arrays_of
 
-from .quantities import Quantity
+from .fit import scatter_correlations
+from .quantities import Observation, Quantity
 from .store_data import (fraction_columns, metric_columns, replicate_deviations, replicate_groups,
                          replicate_store_paths, replicate_stores, seed_scatter, training_tables)
 
@@ -259,8 +260,6 @@ def run_correlations(reps, metrics: list[str]) -> dict[tuple[str, str], float]:
 def one_run_correlation(nets: list[QuantityNet], rho: dict[tuple[str, str], float]) -> np.ndarray:
     """The seed scatter's correlation matrix over the rows of one run (each quantity once, a
     quantity with a shear fraction at three points), with the cross-quantity terms `rho`."""
-    from .fit import scatter_correlations
-    from .quantities import Observation
     row_nets = [n for n in nets for _ in range(3 if "shear_fraction" in n.input_names else 1)]
     rows, seen = [], {}
     for n in row_nets:  # one test: no condition but the shear fraction, which tells its points apart

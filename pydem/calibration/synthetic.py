@@ -22,7 +22,10 @@ import numpy as np
 
 from ..quantity_table import metric_spec
 from .candidates import BASE_PARAMETERS, Candidate
+from .calibrate import fit_base
 from .confirm import rig_values
+from .diagnose import diagnose
+from .fit import condition_correlation, scatter_correlations
 from .quantities import Observation, Quantity, test_conditions
 
 
@@ -160,7 +163,6 @@ def net_error_draw(nets: dict, obs: list[Observation], rng: np.random.Generator,
     over the conditions (fit.condition_correlation), so the likelihood's noise model is the one
     that made the set. The rows' stated uncertainty does not include it (a lab does not know
     our nets); the diagnosis adds it to every row, as it does for measured data."""
-    from .fit import condition_correlation
     out = np.zeros(len(obs))
     by: dict = {}
     for i, o in enumerate(obs):
@@ -182,7 +184,6 @@ def seed_scatter_draw(nets: dict, obs: list[Observation], rng: np.random.Generat
     (fit.scatter_correlations: the shear points of one test, the quantities of one run), and
     different tests are independent. Its size: the nets' error models at the truth's inputs
     where given."""
-    from .fit import scatter_correlations
     out = np.zeros(len(obs))
     rho = scatter_correlations(obs, [nets[o.quantity] for o in obs])
     tests: dict = {}
@@ -203,7 +204,6 @@ def signal(setup, truth: Truth, obs: list[Observation]) -> float:
     statistic scatters about it by the noise (noncentral chi^2_1), so an effect whose signal is
     below the test's critical value (6.6 at p = 0.01) is missed as often as it is found by any
     method on these measurements; 0 for a null set."""
-    from .calibrate import fit_base
     if truth.effect is None:
         return 0.0
     values = surrogate_values(setup.nets, setup.candidates, truth, obs)
@@ -333,7 +333,6 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
     DEM-made ones do). One row per set: truth, verdict, chosen effect, errors before/after."""
     import json
     from pathlib import Path
-    from .diagnose import diagnose
     base_obs = programme(setup.nets)
     rows = []
     done = {}

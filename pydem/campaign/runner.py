@@ -13,6 +13,7 @@ import numpy as np
 from ..progress import CampaignProgress
 from ..provenance import provenance
 from ..rigs import RIGS
+from ..rigs.config import describe
 from .design import at_neutral, design_points
 from .spec import CampaignSpec
 from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError, physics_of
@@ -23,7 +24,6 @@ def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
     error message. Pure (depends on its arguments only); runs in a worker process."""
     t0 = time.perf_counter()
     try:
-        from ..rigs import RIGS
         spec = CampaignSpec.from_json(spec_json)
         cfg = spec.config(values)
         if "num_threads" not in spec.fixed:
@@ -46,7 +46,6 @@ def resolved_config(spec) -> dict:
     """Every knob of the rig as this code resolves the spec's preset and fixed settings (at the
     centre of the ranges; the varied keys and the thread count left out), so a store says what
     "preset default" meant when it was run."""
-    from ..rigs.config import describe
     centre = {k: 0.5 * (lo + hi) for k, (lo, hi) in spec.ranges.items()}
     return {key: (value if isinstance(value, (int, float, str, bool)) else str(value))
             for key, value, _, _ in describe(spec.config(centre)) if key not in spec.ranges

@@ -15,6 +15,8 @@ import os
 import time
 from pathlib import Path
 
+from .config import describe
+
 
 class CheckpointStop(Exception):
     """Raised inside a run when it has saved a checkpoint at its `stop_at` time: the rig returns None."""
@@ -23,7 +25,6 @@ class CheckpointStop(Exception):
 def signature(rig, params, seed: int) -> str:
     """What a checkpoint must match to be resumed: the configuration (threads aside), the
     parameters, the seed and the rig's protocol version."""
-    from .config import describe
     cfg = {k: v if isinstance(v, (int, float, str, bool)) else str(v) for k, v, _, _ in describe(rig.config)
            if k != "num_threads"}
     return json.dumps({"rig": rig.name, "config": cfg, "params": str(params), "seed": seed, "protocol": rig.protocol},

@@ -10,8 +10,10 @@ from typing import Callable
 import numpy as np
 
 from ..domain import Domain
+from ..vtk import VtkSeries
 from .checkpoint import CheckpointStop
-from .config import Params
+from .config import ConfigError, Params
+from .frames import crop_grey
 
 Progress = Callable[[float, float, dict], None]  # (simulated time, planned time, info)
 
@@ -87,7 +89,6 @@ def diameters_from_table(rng: np.random.Generator, n: int, sizes, passing) -> np
     P(d) linear between the sieve sizes (mass uniform in d within each cut). A cut's share of
     the spheres is its mass share times the mean of d^-3 over it (number ~ mass / d^3), and
     within a cut d is drawn with density ~ d^-3 (inverse CDF)."""
-    from .config import ConfigError
     d, cum = np.asarray(sizes, float), np.asarray(passing, float)
     if d.size != cum.size or d.size < 2:
         raise ConfigError(f"psd_sizes and psd_passing need the same number of entries, at least 2 (got {d.size}, {cum.size})")
@@ -187,7 +188,6 @@ class Frames:
 
     def __init__(self, frames_dir: str | Path | None = None, vtk_dir: str | Path | None = None, images: bool = False):
         self.dir = Path(frames_dir) if frames_dir else None
-        from ..vtk import VtkSeries
         self.vtk = VtkSeries(vtk_dir) if vtk_dir else None
         self.images = [] if images else None  # centre-cropped grey frames kept in memory (pydem.rigs.frames)
 
@@ -208,7 +208,6 @@ class Frames:
         if self.vtk is not None:
             self.vtk.write(d)
         if self.images is not None:
-            from .frames import crop_grey
             self.images.append(crop_grey(d.render(**render)))
         if self.dir is None:
             return None

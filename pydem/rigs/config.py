@@ -9,6 +9,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..domain import effects as registry
+
 
 def default_threads() -> int:
     """OpenMP threads of a rig run unless its config says otherwise: OMP_NUM_THREADS when set
@@ -97,7 +99,6 @@ def _locate(cfg, key: str):
         parts = parts[1:] if parts[0] == "params" else parts
         if len(parts) != 3:
             raise ConfigError(f"{key}: effects are set as effects.<effect>.<parameter>=value")
-        from ..domain import effects as registry
         spec = next((e for e in registry() if e["name"] == parts[1]), None)
         if spec is None:
             raise ConfigError(f"{key}: unknown effect {parts[1]!r} (known: {', '.join(e['name'] for e in registry())})")

@@ -25,6 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import geometry
+from ..domain import Domain
+from ..walls import MeshWall
 from .checkpoint import Checkpoint, signature
 from .common import Frames, Stepper, lattice_fill, make_domain, params_from, size_distribution, stable_dt
 from .config import Params, default_threads, knob
@@ -183,8 +185,6 @@ class Tester:
         self.moment = 2.0 * math.pi / 3.0 * (ro ** 3 - ri ** 3)  # integral of r dA over the lid
         self.omega = c.shear_speed / (0.5 * (ri + ro))
         if resume is not None:  # a checkpoint (Checkpoint.load): no filling, no settling
-            from ..domain import Domain
-            from ..walls import MeshWall
             state = resume["protocol"]
             self.d = Domain.from_snapshot(resume["snapshot"])
             self.d.num_threads = c.num_threads
