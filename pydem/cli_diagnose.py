@@ -46,6 +46,6 @@ def main(args) -> int:
     from .calibration import material_card  # the final model: with the effect when one was added
     material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
                                            setup.candidates), args.out)
-    say(f"verdict: {d.verdict}" + (f" ({d.effect})" if d.effect else "") + f" — {report.verdict_line(d)}")
+    say(f"verdict: {d.verdict}" + (f" ({' + '.join(d.effects)})" if d.effect else "") + f" — {report.verdict_line(d)}")
     say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
     return 0

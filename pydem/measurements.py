@@ -10,7 +10,9 @@ refused; a value outside the physically possible range is refused (1.55 "kg/m^3"
 g/cm^3 number);
 conditions: `key=value` pairs separated by `;` from quantity_table.CONDITION_UNITS; uncertainty: one standard
 uncertainty, empty when not published; use: `calibrate` (screened against) or `compare` (shown
-in comparisons only). A UTF-8 byte-order mark and CRLF line ends (a spreadsheet's CSV) are
+in comparisons only); origin (optional column): `lab` (the default: a lab's measurement, its
+uncertainty the lab's repeatability) or `dem` (one DEM run, which also carries that run's seed
+scatter). A UTF-8 byte-order mark and CRLF line ends (a spreadsheet's CSV) are
 accepted; duplicate rows and physically impossible values are refused. Errors name the file,
 line and column."""
 from __future__ import annotations
@@ -22,8 +24,13 @@ from pathlib import Path
 
 from .quantity_table import CONDITION_UNITS, RIG_OF_TEST, TABLE
 
-COLUMNS = ["material", "test", "quantity", "value", "uncertainty", "unit", "conditions", "use", "source"]
+COLUMNS = ["material", "test", "quantity", "value", "uncertainty", "unit", "conditions", "use", "source", "origin"]
 USES = ("calibrate", "compare")
+# where a value comes from, which decides its noise (docs/diagnosis.md §1): a lab's measurement (its
+# uncertainty is the lab's repeatability) or one DEM run (it also carries that run's seed scatter)
+ORIGINS = ("lab", "dem")
+
+
 class MeasurementError(ValueError):
     """A malformed measurement file (the message names the line and the column)."""
 
@@ -40,6 +47,7 @@ class Measurement:
     use: str = "calibrate"
     source: str = ""
     line: int = 0
+    origin: str = "lab"
 
     @property
     def rig(self) -> str | None:
@@ -136,7 +144,12 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
         use = rec.get("use", "") or "calibrate"
         if use not in USES:
             raise MeasurementError(f"{where('use')}: {use!r} is not one of {', '.join(USES)}")
-        m = Measurement(rec["material"], test, quantity, value, unc, si_unit, conditions, use, rec.get("source", ""), lineno)
+        origin = rec.get("origin", "") or "lab"
+        if origin not in ORIGINS:
+            raise MeasurementError(f"{where('origin')}: {origin!r} is not one of {', '.join(ORIGINS)} (lab: a lab's "
+                                   f"measurement, the default; dem: one DEM run)")
+        m = Measurement(rec["material"], test, quantity, value, unc, si_unit, conditions, use, rec.get("source", ""), lineno,
+                        origin)
         key = (m.material, test, quantity, tuple(sorted(conditions.items())))
         if key in seen:
             raise MeasurementError(f"{path}:{lineno}: duplicate of line {seen[key]} (same material, test, quantity "

@@ -7,9 +7,15 @@ set's programme, and sets with two effects at once.
 Two steps, so the expensive part runs once. `run` draws each set's truth and runs the rigs on
 the programme, appending one line per set to a journal (resumable: a rerun does the sets the
 journal lacks; `--part i/n` splits the sets over n processes, each with its own journal).
-`diagnose` adds lab-like noise and scores the diagnosis (studies/independent_sets_score.py).
+`diagnose` adds lab-like noise (seeded per set), writes each set as a measurement file and runs
+`pydem diagnose` of a given checkout on it (so the rules of an earlier commit can be scored on
+the same files), keeping what the verdicts need in one JSON; `summary` tabulates false alarms,
+top-1, error fall and coverage (the truth inside the final model's 95 % intervals).
 
-    .venv/bin/python studies/independent_sets.py run --journal studies/results/independent_sets.jsonl --part 1/2
+    .venv/bin/python studies/independent_sets.py run --journal studies/results/independent_sets_1.jsonl --part 1/2
+    .venv/bin/python studies/independent_sets.py diagnose --journals studies/results/independent_sets_*.jsonl \
+        --label new --out studies/results/independent_sets.new.json [--checkout DIR] [--no-origin]
+    .venv/bin/python studies/independent_sets.py summary studies/results/independent_sets.*.json
 
 The programme: ring shear at pre-shear 1, 2 and 5 kPa with shear points at 45 and 70 % (the
 stores shear at 30, 60 and 90 %), the angle of repose with its poured bulk density, the hopper at
@@ -55,7 +61,7 @@ def detection_limits(setup, theta: dict, obs: list[Observation], inputs: dict) -
     programme at this truth: its base model fitted to the surrogates' noise-free values there."""
     values = synthetic.surrogate_values(setup.nets, setup.candidates, synthetic.Truth(theta, None, None, None), obs)
     clean = [Observation(o.quantity, dict(o.conditions), values[i], synthetic.noise_sd(o.quantity.metric, values[i]),
-                         o.label) for i, o in enumerate(obs)]
+                         o.label, origin="dem") for i, o in enumerate(obs)]
     model, fit = fit_base(clean, setup.nets, setup.ranges, setup.candidates)
     return detectable_effects(model, fit, setup.candidates, setup.nets, setup.ranges, setup.candidates, ALPHA)
 
@@ -113,14 +119,105 @@ def run(args):
               f"{len(obs)} rows, {truth['dem_seconds']:.0f} s", flush=True)
 
 
+TEST_OF = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
+
+
+def measurement_file(path: Path, row: dict, origin: bool):
+    """The set as a measurement file: each rig value with lab-like noise (synthetic.noise_sd; the
+    same draw whatever the rules scored), the noise as its uncertainty, and with `origin` the
+    column saying each row is one DEM run."""
+    rng = np.random.default_rng(SEED + 1000 + row["set"])
+    lines = [f"# independent set {row['set']} ({row['kind']}): truth {row['inputs']}",
+             "material,test,quantity,value,uncertainty,unit,conditions,use,source" + (",origin" if origin else "")]
+    for r in row["rows"]:
+        if r["value"] is None:
+            continue
+        n = synthetic.noise_sd(r["metric"], r["value"])
+        v = max(r["value"] + rng.normal(0.0, n), 1e-3 * abs(r["value"]))
+        cond = ";".join(f"{k}={x:.6g}" for k, x in r["conditions"].items())
+        lines.append(f"set{row['set']},{TEST_OF[r['rig']]},{r['metric']},{v:.8g},{n:.6g},,{cond},calibrate,independent"
+                     + (",dem" if origin else ""))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def diagnose(args):
+    """Each journal's sets diagnosed by `pydem diagnose` of the checkout; one JSON of the results."""
+    import subprocess
+    import tempfile
+    checkout = Path(args.checkout).resolve()
+    rows = sorted((json.loads(x) for j in args.journals for x in Path(j).read_text().splitlines()), key=lambda r: r["set"])
+    out = {"label": args.label, "checkout": str(checkout), "origin_column": not args.no_origin, "sets": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for row in rows:
+            meas = Path(tmp) / f"set{row['set']}.csv"
+            measurement_file(meas, row, not args.no_origin)
+            res = Path(tmp) / f"set{row['set']}"
+            t0 = time.perf_counter()
+            run_ = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", f"set{row['set']}",
+                                   "--out", str(res)], cwd=checkout, capture_output=True, text=True,
+                                  env={**__import__("os").environ, "PYTHONPATH": str(checkout)})
+            if run_.returncode != 0:
+                out["sets"].append({"set": row["set"], "kind": row["kind"], "error": run_.stderr[-500:]})
+                continue
+            d = json.loads((res / "diagnosis.json").read_text())
+            effects = d.get("effects") or ([d["effect"]] if d.get("effect") else [])
+            cover = {}
+            for name, p in d["parameters"].items():
+                truth = row["inputs"].get(name)
+                if truth is not None and p.get("lo") is not None:
+                    cover[name] = bool(p["lo"] <= truth <= p["hi"])
+            out["sets"].append({"set": row["set"], "kind": row["kind"], "truth_effects": row["effects"], "verdict": d["verdict"],
+                                "effects": effects, "p_best": d["candidates"][0]["p_value"] if d["candidates"] else None,
+                                "best": d["candidates"][0]["effect"] if d["candidates"] else None,
+                                "rmse_before": d["before"]["rmse_relative"],
+                                "rmse_after": d["after"]["rmse_relative"] if d.get("after") else None,
+                                "chi2_before": d["before"]["chi2_per_dof"], "covered": cover,
+                                "seconds": time.perf_counter() - t0})
+            s = out["sets"][-1]
+            print(f"set {row['set']:2d} {row['kind']:28s} -> {s['verdict']:18s} {'+'.join(effects) or '-':28s} "
+                  f"covered {sum(cover.values())}/{len(cover)}", flush=True)
+    Path(args.out).write_text(json.dumps(out, indent=1))
+
+
+def summary(args):
+    """False alarms (nulls with any effect named), single effects named right (top-1), two-effect
+    sets with both named, the error after / before, and coverage, per results file."""
+    from scipy import stats
+    for path in args.results:
+        r = json.loads(Path(path).read_text())
+        sets = [s for s in r["sets"] if "error" not in s]
+        nulls = [s for s in sets if s["kind"] == "null"]
+        fa = sum(bool(s["effects"]) or s["verdict"] != "no_effect_needed" for s in nulls)
+        lo, hi = (stats.beta.ppf(0.025, fa, len(nulls) - fa + 1) if fa else 0.0,
+                  stats.beta.ppf(0.975, fa + 1, len(nulls) - fa) if fa < len(nulls) else 1.0)
+        single = [s for s in sets if s["kind"] != "null" and "+" not in s["kind"]]
+        top1 = sum(s["effects"][:1] == [s["kind"]] for s in single)
+        double = [s for s in sets if "+" in s["kind"]]
+        both = sum(sorted(s["effects"]) == sorted(s["kind"].split("+")) for s in double)
+        ratio = [s["rmse_after"] / s["rmse_before"] for s in single + double if s["rmse_after"] and s["rmse_before"]]
+        cov = [c for s in sets for c in s["covered"].values()]
+        print(f"{r['label']}: false alarms {fa}/{len(nulls)} (95 % interval {lo:.2f}-{hi:.2f}); single effects named "
+              f"{top1}/{len(single)}; two-effect sets with both {both}/{len(double)}; error after/before median "
+              f"{np.median(ratio) if ratio else float('nan'):.2f}; coverage {sum(cov)}/{len(cov)} "
+              f"({100 * sum(cov) / max(len(cov), 1):.0f} %); failed runs {len(r['sets']) - len(sets)}")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run")
     r.add_argument("--journal", required=True)
     r.add_argument("--part", default="1/1", help="i/n: the sets k with k mod n = i - 1")
+    dg = sub.add_parser("diagnose")
+    dg.add_argument("--journals", nargs="+", required=True)
+    dg.add_argument("--label", required=True)
+    dg.add_argument("--out", required=True)
+    dg.add_argument("--checkout", default=str(ROOT), help="the pydem to score (default: this one)")
+    dg.add_argument("--no-origin", action="store_true", help="files without the origin column (older readers)")
+    sm = sub.add_parser("summary")
+    sm.add_argument("results", nargs="+")
     args = ap.parse_args()
-    run(args)
+    {"run": run, "diagnose": diagnose, "summary": summary}[args.cmd](args)
     return 0
 
 

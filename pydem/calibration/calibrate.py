@@ -22,7 +22,7 @@ from nn.export import weights_text
 from ..campaign.design import design_points
 from ..mlp import NativeMLP
 from .candidates import Candidate
-from .fit import Fit, Model, minimise, posterior
+from .fit import Fit, Model, fit_own_noise, posterior
 from .quantities import Observation
 
 
@@ -103,13 +103,9 @@ def fit_summary(model: Model, fit: Fit) -> dict:
 
 
 def fit_base(observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate]) -> tuple[Model, Fit]:
-    """The base model (candidates at their neutral values) fitted, with its posterior. Two
-    passes: with the nets' pooled errors, then with their error models at that fit's parameters
-    (fit.Model's `at`), started from the first optimum."""
-    model = Model(observations, nets, ranges, candidates)
-    fit = minimise(model)
-    model = Model(observations, nets, ranges, candidates, at=fit.best)
-    fit = minimise(model, start=fit.best)
+    """The base model (candidates at their neutral values) fitted with the noise model at its own
+    optimum (fit.fit_own_noise), with its posterior."""
+    model, fit = fit_own_noise(observations, nets, ranges, candidates)
     fit.posterior = posterior(model, fit)
     return model, fit
 

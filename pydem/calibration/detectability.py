@@ -111,7 +111,7 @@ def candidate_tests(observations: list, nets: dict, points: int = 4) -> list[tup
             for q in quantities:
                 for f in (fractions if "shear_fraction" in nets[q].input_names else [None]):
                     c = dict(at) if f is None else dict(at, shear_fraction=f)
-                    rows.append(Observation(q, c, 1.0, 0.0, f"{q.key} {c}"))
+                    rows.append(Observation(q, c, 1.0, 0.0, f"{q.key} {c}", origin="dem"))  # a new run's noise
             tests.append((f"{rig}" + (f" at {cond[0]} = {v:.4g} {CONDITION_UNITS.get(cond[0], '')}".rstrip()
                                       if v is not None else ""), rows))
     return tests

@@ -2,8 +2,12 @@
 minimisation in the campaign box, and the posterior for a uniform prior on that box by
 importance sampling.
 
-The noise of row k has two parts. max(u_k, s_q) (u_k the row's stated uncertainty, s_q the rig's
-seed-to-seed scatter) is independent from row to row. The net's own error e_q is not: a smooth
+The noise of row k depends on where the value comes from (row_noise). A lab's measurement
+differs from the model's mean response by the lab's repeatability u_k (its stated uncertainty;
+where none is stated, the rig's seed-to-seed scatter s_q stands in). One DEM run (a DEM-made
+pseudo-measurement) also carries that run's seed scatter: u_k and s_q both. These parts are
+independent from row to row, except the seed scatter within one run or test (below). The net's
+own error e_q is not: a smooth
 net fitted to ~100 runs errs smoothly, so at one parameter point its errors at neighbouring
 conditions (pre-shear stresses, shear fractions, slot widths) are nearly the same number.
 Treated as independent, such an error reads as a coherent trend over the conditions that an
@@ -15,7 +19,7 @@ seed-scatter parts correlate with the net's measured `test_correlation`; so do t
 quantities one run measures (`run_correlation`: a hopper run that flows slowly also takes
 longer to empty; `scatter_correlations`). chi^2 is taken in the
 whitened residuals L^-1 r (C = L L^T). `sigma` stays the marginal standard deviation of each row
-(QuantityNet.row_sigma), for tables and plots.
+(row_noise), for tables and plots.
 
 `Model` maps a vector of free parameters (the base parameters, plus at most a candidate's) to
 the nets' inputs: a candidate that is not free sits at its neutral value, which may follow the
@@ -40,11 +44,16 @@ NET_ERROR_LENGTH = 1.0
 
 class Model:
     def __init__(self, observations: list[Observation], nets: dict, ranges: dict[str, tuple[float, float]],
-                 candidates: list[Candidate], free_candidate: Candidate | None = None, at: np.ndarray | None = None):
+                 candidates: list[Candidate], free_candidate: Candidate | list[Candidate] | None = None,
+                 at: np.ndarray | None = None):
+        """free_candidate: the candidate (or candidates, in order) whose parameter is free beside the
+        base parameters; the others sit at their neutral values."""
         self.obs = observations
         self.nets = [nets[o.quantity] for o in observations]
         self.candidates = {c.parameter: c for c in candidates}
-        self.free = list(BASE_PARAMETERS) + ([free_candidate.parameter] if free_candidate else [])
+        frees = [] if free_candidate is None else list(free_candidate) if isinstance(free_candidate, (list, tuple)) \
+            else [free_candidate]
+        self.free = list(BASE_PARAMETERS) + [c.parameter for c in frees]
         self.free_candidate = free_candidate
         self.lo = np.array([ranges[n][0] for n in self.free])
         self.hi = np.array([ranges[n][1] for n in self.free])
@@ -58,17 +67,16 @@ class Model:
         """Each row's seed scatter, net error and marginal sd: the nets' error models at the row's
         inputs for the parameters `at` (the noise model is then fixed for this Model: chi^2 stays
         a quadratic form, and models compared by their chi^2 share it), or their pooled values
-        (QuantityNet.row_sigma: a measured value scatters at least as much as one rig run)."""
+        (QuantityNet seed_sd and net_error), combined by the row's origin (row_noise)."""
         n_rows = len(self.obs)
         seed, err, sigma = np.zeros(n_rows), np.zeros(n_rows), np.zeros(n_rows)
         for k, (o, n) in enumerate(zip(self.obs, self.nets)):
             if self.at is not None and hasattr(n, "errors_at"):
                 a, b = n.errors_at(self.row_inputs(k, self.at))
-                seed[k], err[k] = a[0], b[0]
-                sigma[k] = n.row_sigma(o.uncertainty, seed[k], err[k])
+                s, e = a[0], b[0]
             else:
-                seed[k], err[k] = getattr(n, "seed_sd", 0.0), getattr(n, "net_error", 0.0)
-                sigma[k] = n.row_sigma(o.uncertainty)
+                s, e = getattr(n, "seed_sd", 0.0), getattr(n, "net_error", 0.0)
+            seed[k], err[k], sigma[k] = row_noise(o, s, e)
         return seed, err, sigma
 
     @property
@@ -171,6 +179,22 @@ class Model:
         return np.sum(r * r, axis=1)
 
 
+def row_noise(o: Observation, seed: float, error: float) -> tuple[float, float, float]:
+    """(the row's share of seed scatter, the net's error, the row's total sd) for a row with one
+    run's seed scatter `seed` and the net's error `error` at its inputs:
+    - a lab's measurement ("lab"): its repeatability u and the net's error, sqrt(u^2 + e^2). The
+      net predicts the model's mean response, and a lab's value is not one DEM run: the DEM
+      specimen's seed scatter is no part of its noise (the finite specimen's size effect is a bias
+      of the model, not noise). Where no u is stated, one run's scatter stands in for it;
+    - one DEM run ("dem"): its stated noise u, that run's seed scatter and the net's error,
+      sqrt(u^2 + s^2 + e^2); the seed part is shared with the other rows of its run or test
+      (scatter_correlations)."""
+    if o.origin == "dem":
+        return seed, error, float(np.sqrt(o.uncertainty ** 2 + seed ** 2 + error ** 2))
+    u = o.uncertainty if o.uncertainty_given else seed
+    return 0.0, error, float(np.sqrt(u ** 2 + error ** 2))
+
+
 def scatter_correlations(obs: list[Observation], nets: list, run_rho: dict | None = None) -> np.ndarray:
     """(n, n) correlation of the rows' seed scatter (nets: each row's net; run_rho: {(metric,
     metric): rho} in place of the nets' `run_correlation`, for a trial set). Rows measured in one
@@ -269,6 +293,26 @@ def minimise(model: Model, starts: int = 4096, keep: int = 6, seed: int = 0, sta
         if c < best_c:
             best_p, best_c = p, c
     return Fit(list(model.free), best_p, best_c, len(model.y), model.lo, model.hi)
+
+
+def fit_own_noise(observations: list[Observation], nets: dict, ranges: dict, candidates: list[Candidate],
+                  free=None, start: np.ndarray | None = None, passes: int = 4, tol: float = 1e-3) -> tuple[Model, Fit]:
+    """A fit judged with the noise model at its own optimum. The nets' error models vary over the
+    campaign box (a cohesive material's runs scatter more than a free-flowing one's), so a fit's
+    noise model is taken where the fit lands: the noise model at the last optimum, a refit from
+    it, until the optimum moves less than `tol` of each range's width (at most `passes` times).
+    Without `start` the first pass takes the nets' pooled errors."""
+    if start is None:
+        start = minimise(Model(observations, nets, ranges, candidates, free)).best
+    at = np.asarray(start, dtype=float)
+    for k in range(passes):
+        model = Model(observations, nets, ranges, candidates, free, at=at)
+        fit = minimise(model, start=at) if k == 0 else minimise(model, starts=256, keep=2, start=at)
+        moved = float(np.max(np.abs(fit.best - at) / (model.hi - model.lo)))
+        at = fit.best
+        if moved < tol:
+            break
+    return model, fit
 
 
 def posterior(model: Model, fit: Fit, samples: int = 2 ** 15, seed: int = 0, edge: float = 0.01) -> dict:

@@ -38,10 +38,13 @@ class Observation:
     uncertainty: float            # the measurement's own standard uncertainty
     label: str
     assumed: dict[str, float] = field(default_factory=dict)  # conditions the file did not give
-    # False: the file gives no uncertainty; the likelihood's floor, the rig's seed-to-seed scatter
-    # (fit.Model: max(u, scatter)), is then the row's whole measurement uncertainty
+    # False: the file gives no uncertainty; the rig's seed-to-seed scatter then stands in for the
+    # lab's repeatability (fit.row_noise)
     uncertainty_given: bool = True
     ignored: dict[str, str] = field(default_factory=dict)  # the file's conditions no surrogate takes (reported)
+    # "lab": a lab's measurement, its uncertainty the lab's repeatability; "dem": one DEM run, which
+    # also carries that run's seed scatter (measurements.ORIGINS; fit.row_noise)
+    origin: str = "lab"
 
     def condition_text(self) -> str:
         return ", ".join(f"{k}={v:g}" + (" (assumed)" if k in self.assumed else "") for k, v in self.conditions.items())
@@ -82,8 +85,9 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
                                    f"(in {CONDITION_UNITS[name] or 'a fraction'})") from None
     ignored = {k: v for k, v in m.conditions.items() if k not in q.conditions}
     if not math.isfinite(m.uncertainty):  # not published (the JKU angles): the rig's seed scatter stands in
-        return Observation(q, cond, float(m.value), 0.0, m.label, assumed, uncertainty_given=False, ignored=ignored)
-    return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed, ignored=ignored)
+        return Observation(q, cond, float(m.value), 0.0, m.label, assumed, uncertainty_given=False, ignored=ignored,
+                           origin=m.origin)
+    return Observation(q, cond, float(m.value), float(m.uncertainty), m.label, assumed, ignored=ignored, origin=m.origin)
 
 
 def test_conditions(o: Observation) -> tuple:

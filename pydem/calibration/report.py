@@ -17,6 +17,8 @@ from .diagnose import ALPHA, Diagnosis
 VERDICT_TEXT = {
     "no_effect_needed": "The base model is consistent with the measurements: no candidate effect is needed.",
     "effect": "One missing effect explains the measurements significantly better than the base model: {effect}.",
+    "effects": "Missing effects explain the measurements significantly better than the base model, each on top of "
+               "the one before: {effects}.",
     "indistinguishable": "Missing effects explain the measurements significantly better than the base model, but "
                          "{effect} and {others} about equally well with these conditions.",
     "unexplained": "The base model fails, and none of the candidate effects explains the misfit.",
@@ -25,7 +27,8 @@ VERDICT_TEXT = {
 
 def verdict_line(d: Diagnosis) -> str:
     sig = [c.effect for c in d.candidates if c.p_value < ALPHA and c.effect != d.effect]
-    line = VERDICT_TEXT[d.verdict].format(effect=d.effect, others=", ".join(sig) or "another candidate")
+    text = VERDICT_TEXT["effects" if d.verdict == "effect" and d.added else d.verdict]
+    line = text.format(effect=d.effect, others=", ".join(sig) or "another candidate", effects=" + ".join(d.effects))
     if not d.testable:
         line += (f" But with {len(d.observations)} measurement(s) for {len(d.base.names)} base parameters no candidate "
                  f"effect could be tested: measure more conditions.")
@@ -200,19 +203,33 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
     sections.append(("Verdict", f"**{d.verdict}** — {verdict_line(d)}", f"<p class='verdict'><b>{d.verdict}</b> — "
                      f"{html.escape(verdict_line(d))}</p>"))
     b, a = data["before"], data["after"]
-    rows = [["base model", _g(b["chi2_per_dof"], ".2f"), b["dof"], _g(b["p_value"], ".2g"), _g(b["rmse_relative"], ".3f"),
-             _g(b["loco_rmse_relative"], ".3f")]]
+    first = d.candidates[0] if a and d.candidates else None
+    rows = [["base model", _g(d.base.chi2, ".2f"), _g(b["chi2_per_dof"], ".2f"), b["dof"], _g(b["p_value"], ".2g"),
+             _g(b["rmse_relative"], ".3f"), _g(b["loco_rmse_relative"], ".3f")]]
     if a:
-        rows.append([f"with {d.effect or (d.candidates[0].effect + ' (not enough)')}", _g(a["chi2_per_dof"], ".2f"), a["dof"],
+        rows.append([f"with {' + '.join(d.effects) or (first.effect + ' (not enough)')}",
+                     _g(first.fit.chi2, ".2f") + f" (with {first.effect})", _g(a["chi2_per_dof"], ".2f"), a["dof"],
                      _g(a["p_value"], ".2g"), _g(a["rmse_relative"], ".3f"), _g(a["loco_rmse_relative"], ".3f")])
-    md, h = page.table(rows, ["model", "chi^2/dof", "dof", "p-value", "RMSE of relative residuals",
-                          "leave-one-condition-out RMSE"])
-    sections.append(("Before and after", md, h))
-    rows = [[c.effect, c.parameter, _g(c.statistic, ".2f"), _g(c.p_value, ".2g"), _g(c.delta_bic, ".1f"),
+    md, h = page.table(rows, ["model", "chi^2 in the test (the base's noise model)", "chi^2/dof (its own noise model)",
+                              "dof", "p-value", "RMSE of relative residuals", "leave-one-condition-out RMSE"])
+    note = ("The test compares both models with one noise model, the base model's at its optimum (fixed before any "
+            "candidate is tried): LR is the drop of that chi^2. Each model's own fit — its intervals, chi^2/dof and "
+            "p-value — takes the noise model where it lands (the nets' error models vary over the campaign box)."
+            if a else "")
+    sections.append(("Before and after", md + (f"\n\n{note}" if note else ""), h + (f"<p>{html.escape(note)}</p>" if note else "")))
+    rows = [[c.effect, c.parameter, _g(d.base.chi2, ".2f"), _g(c.fit.chi2, ".2f"),
+             _g(c.statistic, ".2f"), _g(c.p_value, ".2g"), _g(c.delta_bic, ".1f"),
              _g(c.score, ".2f"), f"{_g(c.estimate)} {c.unit}".strip(), f"{_g(c.neutral)} {c.unit}".strip()]
             for c in d.candidates]
-    md, h = page.table(rows, ["candidate", "parameter", "LR statistic", "p-value", "dBIC", "score", "estimate", "neutral"])
-    extra = ""
+    md, h = page.table(rows, ["candidate", "parameter", "chi^2 base", "chi^2 with it", "LR statistic", "p-value", "dBIC",
+                              "score", "estimate", "neutral"])
+    extra = ("\n\nLR = chi^2 base - chi^2 with it, both with the base model's noise model (the verdict uses exactly "
+             "these numbers); p from chi^2 with one degree of freedom (half of it for a one-sided candidate such as "
+             "cohesion).")
+    for a in d.added:
+        extra += (f"\n\nOn top of {', '.join(d.effects[:d.effects.index(a.effect)])}: {a.effect} LR {a.statistic:.2f}, "
+                  f"p {a.p_value:.2g}, estimate {_g(a.estimate)} {a.unit} (95 % interval {_g(a.estimate_lo)}–"
+                  f"{_g(a.estimate_hi)}) — added (p < {ALPHA:g}, the same level as the first step).")
     if d.not_covered:
         extra = f"\n\nNot covered by these campaigns: {', '.join(d.not_covered)}."
     sims = "; ".join(f"{k.replace('|', ' vs ')}: {v:.2f}" for k, v in d.similarity.items())

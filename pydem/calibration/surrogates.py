@@ -76,15 +76,6 @@ class QuantityNet:
         of the RMSE (also when the scatter is unknown)."""
         return float(np.sqrt(max(self.rmse ** 2 - self.seed_sd ** 2, (0.2 * self.rmse) ** 2)))
 
-    def row_sigma(self, u: float, seed: float | None = None, error: float | None = None) -> float:
-        """Standard deviation of measured - surrogate for a row with stated uncertainty u: a measured
-        value scatters at least as much as one rig run does (a lab's repeat scatter is not smaller
-        than the model specimen's), so max(u, seed scatter), plus the net's error (the pooled
-        seed_sd and net_error, or those of the error model at a point, errors_at)."""
-        seed = self.seed_sd if seed is None else seed
-        error = self.net_error if error is None else error
-        return float(np.sqrt(max(u, seed) ** 2 + error ** 2))
-
     def total_sd(self, x: np.ndarray) -> np.ndarray:
         """(m,): sd of one run about the net at inputs x (m, inputs): the error model where there is
         one (inputs clipped to the campaign box, the sd to [RMSE / ERROR_SPAN, RMSE * ERROR_SPAN]),

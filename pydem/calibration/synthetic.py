@@ -16,7 +16,7 @@ rate), `dem_set` from real rig runs at the campaign preset (a few sets, to check
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -105,17 +105,17 @@ def draw_truth(rng: np.random.Generator, ranges: dict, candidates: list[Candidat
 def with_lab_noise(obs: list[Observation], values: dict, nets: dict, rng: np.random.Generator,
                    truth_inputs: list | None = None) -> list[Observation]:
     """Pseudo-measurements from model values (observation index -> the value before noise: a
-    surrogate mean with seed scatter, or one DEM run): lab noise added, each row's uncertainty
-    the noise and one run's seed scatter combined — the scatter at the truth's inputs
-    (`truth_inputs`, from row_inputs) where given, else the quantity's pooled one."""
+    surrogate mean with seed scatter, or one DEM run): lab noise added. Each row is one run
+    (origin "dem"), its stated uncertainty the lab noise: the likelihood adds one run's seed
+    scatter itself (fit.row_noise). `truth_inputs` (from row_inputs) is kept for the callers; the
+    noise does not depend on it."""
     out = []
     for i, o in enumerate(obs):
         v = values[i]
         n = noise_sd(o.quantity.metric, v)
-        s = seed_sd_at(nets[o.quantity], None if truth_inputs is None else truth_inputs[i])
         # every quantity here is positive: a noise draw below zero (a nearly jammed hopper) is clipped
         value = max(float(v + rng.normal(0.0, n)), 1e-3 * abs(float(v)), 1e-9)
-        out.append(Observation(o.quantity, dict(o.conditions), value, float(math.hypot(n, s)), o.label))
+        out.append(Observation(o.quantity, dict(o.conditions), value, float(n), o.label, origin="dem"))
     return out
 
 
@@ -207,7 +207,7 @@ def signal(setup, truth: Truth, obs: list[Observation]) -> float:
     if truth.effect is None:
         return 0.0
     values = surrogate_values(setup.nets, setup.candidates, truth, obs)
-    clean = [Observation(o.quantity, dict(o.conditions), values[i], o.uncertainty, o.label) for i, o in enumerate(obs)]
+    clean = [replace(o, value=values[i]) for i, o in enumerate(obs)]
     _, fit = fit_base(clean, setup.nets, setup.ranges, setup.candidates)
     return float(fit.chi2)
 
@@ -239,12 +239,12 @@ def journal_set(row: dict, nets: dict, candidates: list[Candidate], rng: np.rand
 def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):
     """A measurement file (docs/measurements.md) of a pseudo-measurement set, its truth in comments."""
     lines = [f"# {note}", f"# truth: {truth.theta}; effect {truth.effect} {truth.parameter} = {truth.strength}",
-             "material,test,quantity,value,uncertainty,unit,conditions,use,source"]
+             "material,test,quantity,value,uncertainty,unit,conditions,use,source,origin"]
     test_of = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
     for o in obs:
         cond = ";".join(f"{k}={v:.6g}" for k, v in o.conditions.items())
         lines.append(f"{material},{test_of[o.quantity.rig]},{o.quantity.metric},{o.value:.8g},{o.uncertainty:.6g},,"
-                     f"{cond},calibrate,synthetic")
+                     f"{cond},calibrate,synthetic,{o.origin}")
     from pathlib import Path
     Path(path).write_text("\n".join(lines) + "\n")
 
@@ -257,7 +257,7 @@ def density_mismatch(obs: list[Observation], factor: float) -> list[Observation]
     out = []
     for o in obs:
         k = factor if metric_spec(o.quantity.metric).scales_with_density else 1.0
-        out.append(Observation(o.quantity, dict(o.conditions), o.value * k, o.uncertainty * k, o.label))
+        out.append(replace(o, value=o.value * k, uncertainty=o.uncertainty * k))
     return out
 
 
@@ -295,7 +295,9 @@ def score_sets(results: list[dict]) -> dict:
             truth_falls = [r["truth_error_after"] / r["truth_error_before"] for r in hit
                            if r.get("truth_error_after") is not None and r["truth_error_before"] > 0]
             seen = [r for r in rows if (r.get("signal") or 0.0) >= SIGNAL_VISIBLE]
-            out[kind] = {"sets": n, "top1": len(hit), "top1_rate": len(hit) / n,
+            # forward selection's extra effects on a one-effect set are false alarms of their own
+            extra = sum(len(r.get("effects") or []) > 1 for r in rows)
+            out[kind] = {"sets": n, "top1": len(hit), "top1_rate": len(hit) / n, "extra_effect_named": extra,
                          "visible_sets": len(seen), "top1_visible": sum(r["effect"] == kind for r in seen),
                          "top1_rate_visible": sum(r["effect"] == kind for r in seen) / len(seen) if seen else None,
                          "by_signal": {f"{lo:g}-{hi:g}": [sum(r["effect"] == kind for r in b), len(b)]
@@ -366,6 +368,7 @@ def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surroga
                                "after": model_error(d.after_model, d.after, means)}
             row = {"kind": kind, "set": k, "source": source, "truth": truth.theta, "effect_truth": truth.effect,
                    "strength": truth.strength, "signal": visible, "verdict": d.verdict, "effect": d.effect,
+                   "effects": d.effects,
                    "best_candidate": d.candidates[0].effect if d.candidates else None,
                    "p_best": d.candidates[0].p_value if d.candidates else None,
                    "chi2_before": s_before["chi2_per_dof"], "rmse_before": s_before["rmse_relative"],

@@ -64,3 +64,16 @@ def test_calibrate_refuses_measurements_that_match_no_campaign(tmp_path):
     assert "hopper:mass_flow_rate" in r.stderr and "angle_of_repose" in r.stderr
 
 
+
+
+def test_a_row_says_whether_it_is_a_labs_measurement_or_one_dem_run(tmp_path):
+    """The optional origin column: lab by default (and when the column is absent), dem for one DEM
+    run; anything else is refused naming the line, the column and the choices."""
+    assert load(write(tmp_path, "x,aor,angle_of_repose,30,0.5,deg,,calibrate,s\n"))[0].origin == "lab"
+    f = tmp_path / "o.csv"
+    f.write_text(HEADER.rstrip("\n") + ",origin\nx,aor,angle_of_repose,30,0.5,deg,,calibrate,s,dem\n"
+                 "x,poured,bulk_density,1500,20,,,calibrate,s,\n")
+    assert [m.origin for m in load(f)] == ["dem", "lab"]
+    f.write_text(HEADER.rstrip("\n") + ",origin\nx,aor,angle_of_repose,30,0.5,deg,,calibrate,s,simulation\n")
+    with pytest.raises(MeasurementError, match=r"o.csv:2, column 'origin': 'simulation' is not one of lab, dem"):
+        load(f)
