@@ -16,7 +16,7 @@ from .cli_inputs import add_common, load_inputs
 
 def add_parser(sub):
     p = sub.add_parser("calibrate", help="posterior of the micro parameters, seed 000's admissible set, exported nets")
-    add_common(p, "build/calibration", 2)
+    add_common(p, "build/calibration")
     p.add_argument("--window", type=float, default=0.05, help="seed 000's relative acceptance window (default 0.05)")
     p.add_argument("--samples", type=int, default=2 ** 20, help="combinations screened natively (default 2^20)")
     p.set_defaults(func=main)

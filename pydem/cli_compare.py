@@ -10,16 +10,15 @@ from __future__ import annotations
 import math
 import sys
 
-from .cli_inputs import load_inputs
+from .cli_inputs import add_stores, load_inputs
 
 
 def add_parser(sub):
-    from .calibration.setup import DEFAULT_STORES
     p = sub.add_parser("compare", help="a model vs measurements, row by row at each condition: residuals, z, overall error")
     p.add_argument("measurements")
     p.add_argument("--material", required=True)
     p.add_argument("--params", help="the surrogates at this parameter set: name=value,name=value")
-    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES), help="campaign stores of the surrogates")
+    add_stores(p)
     p.add_argument("--dem", action="append", default=[], help="rig result JSON (pydem rig ... --out r.json); repeatable")
     p.set_defaults(func=main)
 

@@ -13,7 +13,7 @@ from .cli_inputs import add_common, load_inputs
 
 def add_parser(sub):
     p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
-    add_common(p, "build/diagnosis", 1)
+    add_common(p, "build/diagnosis")
     p.set_defaults(func=main)
 
 

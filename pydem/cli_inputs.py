@@ -8,17 +8,29 @@ import sys
 from pathlib import Path
 
 
-def add_common(p, out: str, threads: int):
+def add_common(p, out: str):
     """The arguments `pydem diagnose` and `pydem calibrate` share."""
-    from .calibration.setup import DEFAULT_STORES
     p.add_argument("measurements", help="measurement file (docs/measurements.md)")
     p.add_argument("--material", required=True)
-    p.add_argument("--stores", nargs="+", default=list(DEFAULT_STORES),
-                   help="campaign stores: one per rig, and others of a rig pooled into its surrogates (default: the shipped diagnosis stores)")
+    add_stores(p)
     p.add_argument("--out", default=out)
     p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
-    p.add_argument("--threads", type=int, default=threads, help=f"threads of the confirming runs (default {threads})")
+    p.add_argument("--threads", type=int, help="threads of the native screening and the confirming runs (default: "
+                                               "OMP_NUM_THREADS when set, else the cores this process may use)")
     p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
+
+
+def add_stores(p):
+    p.add_argument("--stores", nargs="+",
+                   help="campaign stores: one per rig, and others of a rig pooled into its surrogates (default: the "
+                        "shipped diagnosis stores, found from any directory: pydem.shipped)")
+
+
+def store_paths(args) -> list:
+    """The --stores given, else the shipped diagnosis stores wherever they are installed."""
+    from .calibration.setup import DEFAULT_STORES
+    from .shipped import shipped_path
+    return args.stores or [shipped_path(s) for s in DEFAULT_STORES]
 
 
 def load_inputs(args, command: str, say):
@@ -27,9 +39,15 @@ def load_inputs(args, command: str, say):
     from .calibration.setup import load_setup, observations_of
     from .campaign import StoreError
     from .measurements import MeasurementError, load as load_measurements
+    from .rigs.config import default_threads
+    if hasattr(args, "threads"):  # calibrate and diagnose: OMP_NUM_THREADS honoured, screening included
+        args.threads = default_threads() if args.threads is None else args.threads
+        if args.threads < 1:
+            print(f"pydem {command}: --threads must be at least 1, got {args.threads}", file=sys.stderr)
+            return None
     try:
         rows = load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
-        setup = load_setup(args.stores, say, getattr(args, "retrain", False))
+        setup = load_setup(store_paths(args), say, getattr(args, "retrain", False))
         obs, skipped = observations_of(rows, setup, str(args.measurements), args.material)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
         print(f"pydem {command}: {exc}", file=sys.stderr)

@@ -386,9 +386,9 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
                 free.append(next(c for c in covered if c.parameter == nxt.parameter))
                 after_model, after = fit_own_noise(observations, nets, ranges, covered, free, start=nxt.fit.best)
         after.posterior = posterior(after_model, after)
-        for r in [chosen] + added:  # every added effect's interval from the final model
+        for r in [chosen] + added:  # every added effect's estimate and interval: the final model's
             p = after.posterior["parameters"][r.parameter]
-            r.estimate_lo, r.estimate_hi = p["lo"], p["hi"]
+            r.estimate, r.estimate_lo, r.estimate_hi = p["estimate"], p["lo"], p["hi"]
         if after.p_value < ACCEPT:
             notes.append(f"adding {' and '.join([chosen.effect] + [a.effect for a in added])} lowers chi^2/dof from "
                          f"{base.chi2_per_dof:.2f} to {after.chi2_per_dof:.2f}, but the fit is still rejected "

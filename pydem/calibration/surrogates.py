@@ -324,8 +324,13 @@ def _prune_slots(d: Path, keep: Path):
 
 def train(store, say=print, pooled=()) -> dict[Quantity, QuantityNet]:
     """Trains one net per quantity of the store and the stores pooled with it (seeded,
-    deterministic on one machine)."""
-    from nn.mlp import bagged_net, cross_validate
+    deterministic on one machine). Training needs torch, an optional dependency: without it a
+    ValueError says which store lacks cached nets and how to install it."""
+    try:
+        from nn.mlp import bagged_net, cross_validate  # torch: only where nets are trained
+    except ImportError as exc:
+        raise ValueError(f"{store.path}: no cached surrogate nets for these runs, and training them needs torch "
+                         f"(pip install 'pydem[nn]'; {exc})") from None
     nets = {}
     for q, (names, x, y) in training_tables(store, pooled).items():
         if len(y) < 20:

@@ -226,3 +226,43 @@ def test_nets_cached_per_training_set(tmp_path, monkeypatch):
     assert trained == [1, 2, 3] and len(slots) == surrogates.SLOTS
     names = {p.name for p in slots}
     assert surrogates.store_hash(store) in names and surrogates.store_hash(store, (store,)) not in names
+
+
+def test_the_commands_find_the_shipped_stores_from_any_directory(tmp_path):
+    """The default stores are found wherever the command runs (pydem.shipped: $PYDEM_DATA, the
+    package's copy, the checkout); a name none of them holds is refused naming every place
+    searched and the variable that points elsewhere."""
+    import os
+    import subprocess
+    import sys
+    from pydem.shipped import shipped_path
+    meas = ROOT / "data/measurements/synthetic_cohesive.csv"
+    run = subprocess.run([sys.executable, "-m", "pydem", "compare", str(meas), "--material", "synthetic_cohesive",
+                          "--params", "friction=0.43,rolling_friction=0.12,restitution=0.44"], cwd=tmp_path,
+                         capture_output=True, text=True, env={**os.environ, "PYDEM_DATA": str(tmp_path / "none")})
+    assert run.returncode == 0, run.stderr
+    assert "rows: RMSE of relative residuals" in run.stdout
+    assert shipped_path("data/campaigns/diag_aor_default.h5").is_file()
+    with pytest.raises(FileNotFoundError, match="campaigns/nope.h5: not among the shipped data .* PYDEM_DATA"):
+        shipped_path("data/campaigns/nope.h5")
+
+
+def test_calibrate_screens_on_the_threads_omp_num_threads_gives():
+    """Without --threads, calibrate and diagnose take OMP_NUM_THREADS (else every core), the
+    native screening included; --threads 0 is refused before any work."""
+    import argparse
+    import os
+    from pydem.calibration.setup import TINY_STORES
+    from pydem.cli_inputs import add_common, load_inputs
+    ap = argparse.ArgumentParser()
+    add_common(ap, "out")
+    old = os.environ.get("OMP_NUM_THREADS")
+    os.environ["OMP_NUM_THREADS"] = "1"
+    try:
+        args = ap.parse_args([str(ROOT / "data/measurements/synthetic_cohesive.csv"), "--material", "synthetic_cohesive",
+                              "--stores", *[str(ROOT / s) for s in TINY_STORES]])
+        assert load_inputs(args, "calibrate", lambda *a: None) is not None and args.threads == 1
+    finally:
+        os.environ.pop("OMP_NUM_THREADS") if old is None else os.environ.__setitem__("OMP_NUM_THREADS", old)
+    args = ap.parse_args(["x.csv", "--material", "m", "--threads", "0"])
+    assert load_inputs(args, "calibrate", lambda *a: None) is None

@@ -1,6 +1,7 @@
 """Packaging: one version everywhere, a wheel that carries libdem inside and imports away from
 the checkout, the `pydem` command, and a C library that builds and installs without Python
 (portable flags, versioned soname, no rpath) and links from its pkg-config file."""
+import json
 import re
 import shutil
 import subprocess
@@ -107,6 +108,16 @@ def test_wheel_builds_libdem_from_sources_and_runs_outside_the_checkout(tmp_path
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr[-3000:]
     assert run.stdout.strip().startswith(str(target)), run.stdout
+    # the main job from a directory outside the checkout, on the stores and cached nets the wheel carries
+    assert any(n.startswith("pydem/data/campaigns/") and n.endswith(".h5") for n in names)
+    meas = target / "pydem/data/measurements/synthetic_cohesive.csv"
+    job = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", "synthetic_cohesive",
+                          "--out", "diag"], cwd=tmp_path, env={"PYTHONPATH": str(target), "PATH": "/usr/bin:/bin"},
+                         capture_output=True, text=True)
+    assert job.returncode == 0, job.stderr[-3000:]
+    report = json.loads((tmp_path / "diag/diagnosis.json").read_text())
+    assert report["effect"] == "cohesion_sjkr"
+    assert all(s["path"].startswith(str(target)) for s in report["context"]["stores"].values())
 
 
 @pytest.mark.parametrize("call, compiles", [
