@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import report_page as page
+from ..quantity_table import metric_spec
 from ..rigs.result import strict_json
 from .diagnose import ALPHA, Diagnosis
 
@@ -99,6 +100,8 @@ def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.
                 else:  # one point: the band as an error bar
                     ax.errorbar(xm, y, yerr=sd, fmt="none", color=col, alpha=0.5 if m == 0 else 0.9, capsize=3)
         ax.set_title(q.key, fontsize=10)
+        unit = metric_spec(q.metric).unit  # the one quantity table's
+        ax.set_ylabel(q.metric.replace("_", " ") + (f" ({unit})" if unit else ""))
         if cname == "preshear_stress":
             ax.set_xscale("log")
             ax.set_xticks(sorted({observations[i].conditions[cname] for i in idx}))
@@ -112,7 +115,7 @@ def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     fig.suptitle("measured (bars: stated uncertainty) vs model (bands: ±1 sigma of measured − model at that "
-                 "model's estimate: max(stated, seed scatter) and the nets' error)", fontsize=9)
+                 "model's estimate: the row's noise by its origin and the nets' error)", fontsize=9)
     return page.png(fig)
 
 
