@@ -50,9 +50,10 @@ WALL_OFFSET = 0.05  # |wall friction - particle friction| of a null material, at
 KINDS = (["null"] * 12 + ["cohesion_sjkr"] * 3 + ["wall_friction"] * 3 + ["size_spread"] * 3
          + ["cohesion_sjkr+wall_friction", "cohesion_sjkr+size_spread", "wall_friction+size_spread"])
 SEED = 7000
-# the order the sets are run in: nine nulls, the effect sets, then the last three nulls (a run cut
-# short still has every kind)
-ORDER = list(range(9)) + list(range(12, len(KINDS))) + [9, 10, 11]
+# the order the sets are run in, so that a run cut short still has every kind: eight nulls, then
+# the effect sets interleaved (one of each single effect and a two-effect set per round), then the
+# last four nulls; `--part i/n` takes every n-th set of this order
+ORDER = list(range(8)) + [12, 21, 15, 18, 13, 22, 16, 19, 14, 23, 17, 20] + [8, 9, 10, 11]
 
 
 def programme(nets) -> list[Observation]:
@@ -107,9 +108,9 @@ def run(args):
     part, parts = (int(x) for x in args.part.split("/"))
     journal = Path(args.journal)
     done = {json.loads(x)["set"] for x in journal.read_text().splitlines()} if journal.exists() else set()
-    for k in ORDER:
+    for k in ORDER[part - 1::parts]:
         kind = KINDS[k]
-        if k % parts != part - 1 or k in done:
+        if k in done:
             continue
         t0 = time.perf_counter()
         truth = draw(setup, k, kind, obs)
@@ -211,7 +212,7 @@ def main() -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run")
     r.add_argument("--journal", required=True)
-    r.add_argument("--part", default="1/1", help="i/n: the sets k with k mod n = i - 1")
+    r.add_argument("--part", default="1/1", help="i/n: every n-th set of ORDER, from the i-th")
     dg = sub.add_parser("diagnose")
     dg.add_argument("--journals", nargs="+", required=True)
     dg.add_argument("--label", required=True)
