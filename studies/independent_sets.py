@@ -152,8 +152,13 @@ def diagnose(args):
     checkout = Path(args.checkout).resolve()
     rows = sorted((json.loads(x) for j in args.journals for x in Path(j).read_text().splitlines()), key=lambda r: r["set"])
     out = {"label": args.label, "checkout": str(checkout), "origin_column": not args.no_origin, "sets": []}
+    if Path(args.out).exists():  # resumable: the sets diagnosed already are kept
+        out["sets"] = [s for s in json.loads(Path(args.out).read_text())["sets"] if "error" not in s]
+    done = {s["set"] for s in out["sets"]}
     with tempfile.TemporaryDirectory() as tmp:
         for row in rows:
+            if row["set"] in done:
+                continue
             meas = Path(tmp) / f"set{row['set']}.csv"
             measurement_file(meas, row, not args.no_origin)
             res = Path(tmp) / f"set{row['set']}"
@@ -181,7 +186,7 @@ def diagnose(args):
             s = out["sets"][-1]
             print(f"set {row['set']:2d} {row['kind']:28s} -> {s['verdict']:18s} {'+'.join(effects) or '-':28s} "
                   f"covered {sum(cover.values())}/{len(cover)}", flush=True)
-    Path(args.out).write_text(json.dumps(out, indent=1))
+            Path(args.out).write_text(json.dumps(out, indent=1))
 
 
 def summary(args):
