@@ -23,6 +23,8 @@ class QuantitySpec:
 
 # the rig that models each test ("poured": the bulk density of the angle-of-repose rig's filled cylinder)
 RIG_OF_TEST = {"ring_shear": "ring-shear", "aor": "aor", "hopper": "hopper", "poured": "aor"}
+# the test a rig's own value is written as in a measurement file (a DEM-made set)
+TEST_OF_RIG = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
 # every condition a measurement row may give, with its unit
 CONDITION_UNITS = {"preshear_stress": "Pa", "shear_fraction": "", "slot_width": "m", "size_cut_mm": "mm",
                    "mean_diameter_mm": "mm"}

@@ -41,6 +41,7 @@ from pydem.calibration.detectability import detectable_effects  # noqa: E402
 from pydem.calibration.diagnose import ALPHA  # noqa: E402
 from pydem.calibration.quantities import Observation  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, load_setup  # noqa: E402
+from pydem.quantity_table import TEST_OF_RIG  # noqa: E402
 
 PRESHEAR = (1000.0, 2000.0, 5000.0)
 FRACTIONS = (0.45, 0.7)
@@ -124,9 +125,6 @@ def run(args):
               f"{len(obs)} rows, {truth['dem_seconds']:.0f} s", flush=True)
 
 
-TEST_OF = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
-
-
 def measurement_file(path: Path, row: dict, origin: bool):
     """The set as a measurement file: each rig value with lab-like noise (synthetic.noise_sd; the
     same draw whatever the rules scored), the noise as its uncertainty, and with `origin` the
@@ -140,7 +138,7 @@ def measurement_file(path: Path, row: dict, origin: bool):
         n = synthetic.noise_sd(r["metric"], r["value"])
         v = max(r["value"] + rng.normal(0.0, n), 1e-3 * abs(r["value"]))
         cond = ";".join(f"{k}={x:.6g}" for k, x in r["conditions"].items())
-        lines.append(f"set{row['set']},{TEST_OF[r['rig']]},{r['metric']},{v:.8g},{n:.6g},,{cond},calibrate,independent"
+        lines.append(f"set{row['set']},{TEST_OF_RIG[r['rig']]},{r['metric']},{v:.8g},{n:.6g},,{cond},calibrate,independent"
                      + (",dem" if origin else ""))
     path.write_text("\n".join(lines) + "\n")
 

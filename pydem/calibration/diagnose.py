@@ -331,7 +331,6 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
     results, mjs = [], {}
     # the base is fitted with the noise model at its own optimum (fit_base); every candidate is
     # tested with that noise model (module docstring)
-    ref_model, ref = base_model, base
     for c in covered_for_tests:
         s, step, mje = _score(base_model, base, c.parameter)
         if c.side == "+" and step < 0:  # one-sided: a step to unphysical values scores nothing
@@ -345,10 +344,10 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
     results.sort(key=lambda r: (-r.statistic, r.effect))
     detectable = {}
     if covered_for_tests and detection_limits:
-        detectable = detectable_effects(ref_model, ref, covered_for_tests, nets, ranges, covered, ALPHA)
+        detectable = detectable_effects(base_model, base, covered_for_tests, nets, ranges, covered, ALPHA)
         tests = candidate_tests(observations, nets)
         for c in covered_for_tests:
-            detectable[c.name]["measure_next"] = best_next_measurement(ref_model, ref, c, tests, nets, ranges, covered)
+            detectable[c.name]["measure_next"] = best_next_measurement(base_model, base, c, tests, nets, ranges, covered)
     similarity = {}
     for i, a in enumerate(results):
         for b in results[i + 1:]:

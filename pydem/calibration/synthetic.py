@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..quantity_table import metric_spec
+from ..quantity_table import TEST_OF_RIG, metric_spec
 from .candidates import BASE_PARAMETERS, Candidate
 from .calibrate import fit_base
 from .confirm import rig_values
@@ -240,10 +240,9 @@ def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str)
     """A measurement file (docs/measurements.md) of a pseudo-measurement set, its truth in comments."""
     lines = [f"# {note}", f"# truth: {truth.theta}; effect {truth.effect} {truth.parameter} = {truth.strength}",
              "material,test,quantity,value,uncertainty,unit,conditions,use,source,origin"]
-    test_of = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
     for o in obs:
         cond = ";".join(f"{k}={v:.6g}" for k, v in o.conditions.items())
-        lines.append(f"{material},{test_of[o.quantity.rig]},{o.quantity.metric},{o.value:.8g},{o.uncertainty:.6g},,"
+        lines.append(f"{material},{TEST_OF_RIG[o.quantity.rig]},{o.quantity.metric},{o.value:.8g},{o.uncertainty:.6g},,"
                      f"{cond},calibrate,synthetic,{o.origin}")
     from pathlib import Path
     Path(path).write_text("\n".join(lines) + "\n")
