@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .cli_inputs import check_writable
+from .cli_inputs import check_writable, seed_value
 from .errors import DemError
 from .progress import RunProgress
 from .rigs import RIGS, ConfigError, load
@@ -26,7 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--preset", default="default", help="size preset: tiny, default, paper (ring shear also: cell)")
     rig.add_argument("--config", help="TOML file with keys (and [params], [effects.<name>] tables)")
     rig.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override one key (repeatable)")
-    rig.add_argument("--seed", type=int, default=0)
+    rig.add_argument("--seed", type=seed_value, default=0)
     rig.add_argument("--out", help="result file (.h5, or JSON for any other name)")
     rig.add_argument("--frames", help="directory for PNG frames")
     rig.add_argument("--vtk", help="directory for a VTK time series at the frame times (ParaView: open particles.pvd)")

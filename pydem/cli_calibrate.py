@@ -11,7 +11,12 @@ import sys
 import time
 from pathlib import Path
 
+from . import output_dir
 from .cli_inputs import add_common, load_inputs
+
+# combinations screened at most: the screening holds a float64 per combination and row (2^22 x 30
+# rows: 1 GiB), and seed 000 screened 10^6
+MAX_SAMPLES = 2 ** 22
 
 
 def add_parser(sub):
@@ -39,9 +44,14 @@ def main(args) -> int:
     from .calibration.calibrate import calibrate
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
-    if args.samples < 1 or not 0 < args.window < 1:
-        print(f"pydem calibrate: --samples must be positive and --window in (0, 1) (got {args.samples}, {args.window})",
-              file=sys.stderr)
+    if not 1 <= args.samples <= MAX_SAMPLES or not 0 < args.window < 1:
+        print(f"pydem calibrate: --samples must lie in 1..{MAX_SAMPLES} (2^22) and --window in (0, 1) (got "
+              f"{args.samples}, {args.window})", file=sys.stderr)
+        return 2
+    try:
+        output_dir.check(args.out)  # before any work
+    except output_dir.OutputError as exc:
+        print(f"pydem calibrate: {exc}", file=sys.stderr)
         return 2
     loaded = load_inputs(args, "calibrate", say)
     if loaded is None:
@@ -51,9 +61,6 @@ def main(args) -> int:
     c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
                   args.threads, say)
     c.notes += [f"left out: {line}" for line in skipped]
-    out = Path(args.out)
-    files = export_nets(setup.nets, out / "nets")
-    say(f"  {len(files)} surrogates exported to {out / 'nets'} (libdem weights files, C99 sources in nets/c)")
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
                "stores": setup.store_provenance(), "window": args.window, "samples": args.samples}
@@ -61,8 +68,17 @@ def main(args) -> int:
         from .calibration.confirm import confirm
         from .progress import RunProgress
         context["confirm"] = confirm(setup, c.fit, obs, args.threads, say, RunProgress())
-    path = report.write_calibration(c, out, context)
     from .calibration import material_card
-    material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates), out)
-    say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
+    out = Path(args.out)
+    try:
+        with output_dir.staged(out) as tmp:
+            files = export_nets(setup.nets, tmp / "nets")
+            report.write_calibration(c, tmp, context)
+            material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates), tmp)
+    except OSError as exc:
+        print(f"pydem calibrate: cannot write the output ({exc}); an earlier output in {out} is left as it was",
+              file=sys.stderr)
+        return 1
+    say(f"  {len(files)} surrogates exported to {out / 'nets'} (libdem weights files, C99 sources in nets/c)")
+    say(f"report: {out / 'report.html'} ({time.perf_counter() - t0:.0f} s)")
     return 0

@@ -8,6 +8,9 @@ from __future__ import annotations
 import sys
 import time
 
+from pathlib import Path
+
+from . import output_dir
 from .cli_inputs import add_common, load_inputs
 
 
@@ -22,6 +25,11 @@ def main(args) -> int:
     from .calibration.diagnose import diagnose
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
+    try:
+        output_dir.check(args.out)  # before any work
+    except output_dir.OutputError as exc:
+        print(f"pydem diagnose: {exc}", file=sys.stderr)
+        return 2
     loaded = load_inputs(args, "diagnose", say)
     if loaded is None:
         return 2
@@ -42,10 +50,16 @@ def main(args) -> int:
         from .progress import RunProgress
         fit = d.after if d.after is not None else d.base
         context["confirm"] = confirm(setup, fit, obs, args.threads, say, RunProgress())
-    path = report.write(d, args.out, context)
     from .calibration import material_card  # the final model: with the effect when one was added
-    material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
-                                           setup.candidates), args.out)
+    try:
+        with output_dir.staged(args.out) as tmp:
+            report.write(d, tmp, context)
+            material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
+                                                   setup.candidates), tmp)
+    except OSError as exc:
+        print(f"pydem diagnose: cannot write the output ({exc}); an earlier output in {args.out} is left as it was",
+              file=sys.stderr)
+        return 1
     say(f"verdict: {d.verdict}" + (f" ({' + '.join(d.effects)})" if d.effect else "") + f" — {report.verdict_line(d)}")
-    say(f"report: {path} ({time.perf_counter() - t0:.0f} s)")
+    say(f"report: {Path(args.out) / 'report.html'} ({time.perf_counter() - t0:.0f} s)")
     return 0

@@ -57,6 +57,19 @@ def load_inputs(args, command: str, say):
     return setup, obs, skipped
 
 
+def seed_value(text: str) -> int:
+    """argparse type of every --seed: an integer in 0..MAX_SEED, else a usage error naming the range."""
+    import argparse
+    from .domain import MAX_SEED
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if not 0 <= v <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{text} is outside 0..{MAX_SEED}")
+    return v
+
+
 def check_writable(path: str, directory: bool):
     """Raises OSError naming the path when it cannot be written (a directory is created)."""
     p = Path(path)

@@ -15,6 +15,9 @@ from .cdata import as_c_array, c_definition, c_pointer
 from .errors import DemInvalidArgument, DemUnknownError, check
 from .walls import MeshWall, PlaneWall
 
+# the largest seed anywhere in pydem: libdem's is a uint64, and a store keeps seeds as int64
+MAX_SEED = 2 ** 63 - 1
+
 ROLLING_MODELS = {"cdt": lib.DEM_ROLLING_CDT, "epsd": lib.DEM_ROLLING_EPSD, "epsd2": lib.DEM_ROLLING_EPSD2}
 REGIONS = {"box": lib.DEM_REGION_BOX, "cylinder": lib.DEM_REGION_CYLINDER, "annular_sector": lib.DEM_REGION_ANNULAR_SECTOR}
 COLOR_MODES = {"material": lib.DEM_COLOR_MATERIAL, "scalar": lib.DEM_COLOR_SCALAR, "grey": lib.DEM_COLOR_GREY}
@@ -119,6 +122,8 @@ class Domain:
 
     @seed.setter
     def seed(self, value: int):
+        if not 0 <= int(value) <= MAX_SEED:
+            raise DemInvalidArgument(f"seed {value} outside 0..{MAX_SEED}")
         self._check(lib.dem_domain_set_seed(self._d, int(value)))
 
     # ---- materials and pairs ---------------------------------------------------------------

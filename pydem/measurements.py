@@ -29,6 +29,10 @@ USES = ("calibrate", "compare")
 # where a value comes from, which decides its noise (docs/diagnosis.md §1): a lab's measurement (its
 # uncertainty is the lab's repeatability) or one DEM run (it also carries that run's seed scatter)
 ORIGINS = ("lab", "dem")
+# limits a file is checked against before anything else (a lab programme is tens of rows of short fields)
+MAX_BYTES = 4 * 2 ** 20
+MAX_ROWS = 2000
+MAX_LINE = 4000
 
 
 class MeasurementError(ValueError):
@@ -83,13 +87,26 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
     """All rows (or those of one material); raises MeasurementError naming line and column."""
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if size > MAX_BYTES:
+            raise MeasurementError(f"{path}: {size / 2 ** 20:.1f} MiB; a measurement file is at most "
+                                   f"{MAX_BYTES // 2 ** 20} MiB (a lab programme is tens of rows)")
         lines = path.read_text(encoding="utf-8-sig").splitlines()  # a BOM and CRLF are a spreadsheet's
     except (OSError, UnicodeDecodeError) as exc:
         raise MeasurementError(f"{path}: cannot read ({exc})") from None
     numbered = [(i + 1, ln) for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
     if not numbered:
         raise MeasurementError(f"{path}: no header and no rows")
-    rows = list(csv.reader([ln for _, ln in numbered]))
+    if len(numbered) - 1 > MAX_ROWS:
+        raise MeasurementError(f"{path}: {len(numbered) - 1} rows; at most {MAX_ROWS} are read (the diagnosis's cost "
+                               f"grows with the rows squared: split the file by material)")
+    for lineno, ln in numbered:
+        if len(ln) > MAX_LINE:
+            raise MeasurementError(f"{path}:{lineno}: a line of {len(ln)} characters; at most {MAX_LINE}")
+    try:
+        rows = list(csv.reader([ln for _, ln in numbered]))
+    except csv.Error as exc:  # a NUL byte, a field past csv's own limit
+        raise MeasurementError(f"{path}: not a CSV file ({exc})") from None
     header = [h.strip() for h in rows[0]]
     missing = [c for c in COLUMNS[:5] if c not in header]
     if missing:

@@ -24,6 +24,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..domain import MAX_SEED
 from ..rigs import RIGS, ConfigError, load
 
 
@@ -54,8 +55,8 @@ class CampaignSpec:
             raise SpecError(f"rig: unknown rig {self.rig!r} (known: {', '.join(sorted(RIGS))})")
         if self.design not in ("sobol", "lhs"):
             raise SpecError(f"design: {self.design!r} is not sobol or lhs")
-        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
-            raise SpecError(f"seed: expected a non-negative integer, got {self.seed!r}")
+        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or not 0 <= self.seed <= MAX_SEED:
+            raise SpecError(f"seed: expected an integer in 0..{MAX_SEED}, got {self.seed!r}")
         if not isinstance(self.samples, int) or self.samples < 1:
             raise SpecError(f"samples: expected a positive integer, got {self.samples!r}")
         if not isinstance(self.replicates, int) or self.replicates < 1:

@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 
+from ..cli_inputs import seed_value
 from ..rigs.table1 import TABLE1
 from .gra import PARAMETERS, gra_tables, parameter_row
 from .store import FrameStore
@@ -85,7 +86,7 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
         e.add_argument("--size", type=int, default=64, help="frame side after area-averaging the 224 x 224 crop")
         e.add_argument("--epochs", type=int)
         e.add_argument("--every", type=int, help="use every N-th stored frame (compare, point-to-point)")
-        e.add_argument("--seed", type=int, default=0)
+        e.add_argument("--seed", type=seed_value, default=0)
         e.add_argument("--threads", type=int, default=2, help="torch threads")
         if name != "process":
             e.add_argument("--checkpoints", help="folder of the training checkpoints (default: --out)")

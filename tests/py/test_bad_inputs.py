@@ -22,6 +22,9 @@ def files(tmp: Path) -> dict:
         "cond.csv": HEADER + "x,ring_shear,mu_ie_ps,0.5,0.01,,sigma=1,calibrate,s\n",
         "seed.toml": 'rig = "aor"\npreset = "tiny"\nseed = 1.5\n[ranges]\nfriction = [0.1, 0.5]\n',
         "bool.toml": "friction = true\n",
+        "long_field.csv": HEADER + "x,aor,angle_of_repose,30,0.5,deg,,calibrate," + "s" * 200000 + "\n",
+        "many_rows.csv": HEADER + "".join(f"x,hopper,mass_flow_rate,0.5,0.01,kg/s,slot_width={0.03 + i * 1e-6:.6f},"
+                                          f"calibrate,s\n" for i in range(2001)),
         "stl_bad.stl": "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0\n",
     }
     for name, text in made.items():
@@ -38,7 +41,7 @@ PROBES = [  # (argv with {file} placeholders, words the message must contain)
     (["rig", "aor", "--preset", "huge"], "unknown preset"),
     (["rig", "aor", "--preset", "tiny", "--set", "effects.cohesion_sjkr.energy_density=1"], "has parameters"),
     (["rig", "hopper", "--preset", "tiny", "--out", "/nonexistent/dir/r.json"], "cannot write the output"),
-    (["campaign", "run", "{seed.toml}", "--store", "{tmp}/s.h5"], "seed: expected a non-negative integer"),
+    (["campaign", "run", "{seed.toml}", "--store", "{tmp}/s.h5"], "seed: expected an integer in 0..9223372036854775807"),
     (["campaign", "status", "{tmp}/none.h5"], "no such campaign store"),
     (["campaign", "export", "data/campaigns/aor_tiny.h5", "--csv", "/nonexistent/x.csv"], "No such file or directory"),
     (["compare", "{g_cm3.csv}", "--material", "x", "--dem", "r.json"], "is outside the physically possible range"),
@@ -49,7 +52,16 @@ PROBES = [  # (argv with {file} placeholders, words the message must contain)
     (["calibrate", "{hopper_only.csv}", "--material", "x", "--stores", "data/campaigns/diag_aor_tiny.h5",
       "--out", "{tmp}/cal"], "can be compared with the campaigns"),
     (["calibrate", "{hopper_only.csv}", "--material", "x", "--samples", "0", "--out", "{tmp}/cal"],
-     "--samples must be positive"),
+     "--samples must lie in 1..4194304"),
+    (["calibrate", "{hopper_only.csv}", "--material", "x", "--samples", "1000000000", "--out", "{tmp}/cal"],
+     "--samples must lie in 1..4194304"),
+    # limits, checked before any work
+    (["rig", "aor", "--preset", "tiny", "--seed", "99999999999999999999"], "outside 0..9223372036854775807"),
+    (["diagnose", "{long_field.csv}", "--material", "x"], "a line of 200044 characters; at most 4000"),
+    (["diagnose", "{many_rows.csv}", "--material", "x"], "2001 rows; at most 2000 are read"),
+    (["diagnose", "{hopper_only.csv}", "--material", "x", "--out", "{hopper_only.csv}"], "a file is in the way"),
+    (["calibrate", "{hopper_only.csv}", "--material", "x", "--out", "{tmp}"], "not an earlier pydem output"),
+    (["diagnose", "{hopper_only.csv}", "--material", "x", "--out", "/proc/pydem/out"], "cannot create its parent"),
     (["compare", "{hopper_only.csv}", "--material", "x"], "give --params"),
     (["diagnose", "{unknown_test.csv}", "--material", "x"], "unknown test 'silo'"),
     (["diagnose", "{hopper_only.csv}", "--material", "y"], "no rows for material 'y'"),
