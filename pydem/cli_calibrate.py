@@ -74,11 +74,13 @@ def main(args) -> int:
         with output_dir.staged(out) as tmp:
             files = export_nets(setup.nets, tmp / "nets")
             report.write_calibration(c, tmp, context)
-            material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates), tmp)
+            material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates, c.verdict,
+                                                   report.calibration_line(c)), tmp)
     except OSError as exc:
         print(f"pydem calibrate: cannot write the output ({exc}); an earlier output in {out} is left as it was",
               file=sys.stderr)
         return 1
     say(f"  {len(files)} surrogates exported to {out / 'nets'} (libdem weights files, C99 sources in nets/c)")
+    say(f"verdict: {c.verdict} — {report.calibration_line(c)}")
     say(f"report: {out / 'report.html'} ({time.perf_counter() - t0:.0f} s)")
     return 0

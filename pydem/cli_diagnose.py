@@ -55,7 +55,7 @@ def main(args) -> int:
         with output_dir.staged(args.out) as tmp:
             report.write(d, tmp, context)
             material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
-                                                   setup.candidates), tmp)
+                                                   setup.candidates, d.verdict, report.verdict_line(d)), tmp)
     except OSError as exc:
         print(f"pydem diagnose: cannot write the output ({exc}); an earlier output in {args.out} is left as it was",
               file=sys.stderr)

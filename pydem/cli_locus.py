@@ -21,7 +21,7 @@ def add_parser(sub):
 
 
 def main(args) -> int:
-    from .rigs.yield_locus import Locus, plot_loci
+    from .rigs.yield_locus import Locus, flowability, plot_loci
     loci = []
     for f in args.results:
         try:
@@ -40,11 +40,18 @@ def main(args) -> int:
     except ValueError as exc:
         print(f"pydem locus: {exc}", file=sys.stderr)
         return 2
-    print("| locus | sigma_pre (Pa) | sigma_1 (Pa) | sigma_c (Pa) | ffc | phi_e (deg) | phi_lin (deg) | phi_sf (deg) | c (Pa) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    materials = list(dict.fromkeys(lc.material for lc in loci))
+    print("| locus | material | sigma_pre (Pa) | sigma_1 (Pa) | sigma_c (Pa) | ffc | flowability (Jenike) | phi_e (deg) "
+          "| phi_lin (deg) | phi_sf (deg) | c (Pa) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for lc, r in rows:
-        print(f"| {lc.label} | {lc.sigma_pre:.0f} | {r.sigma_1:.0f} | {r.sigma_c:.0f} | {r.ffc:.3g} | {r.phi_e:.1f} | "
-              f"{r.phi_lin:.1f} | {r.phi_sf:.1f} | {r.cohesion:.0f} |")
+        print(f"| {lc.label} | {materials.index(lc.material) + 1} | {lc.sigma_pre:.0f} | {r.sigma_1:.0f} | "
+              f"{r.sigma_c:.0f} | {r.ffc:.3g} | {flowability(r.ffc)} | {r.phi_e:.1f} | {r.phi_lin:.1f} | "
+              f"{r.phi_sf:.1f} | {r.cohesion:.0f} |")
+    if len(materials) > 1:
+        print("\nmaterials (the rig's configuration but for the consolidation stress; each has its own flow function):")
+        for m, material in enumerate(materials):
+            print(f"  {m + 1}: {material or '(not stated in the result)'}")
     if args.plot:
         plot_loci(loci, args.plot)
         print(f"plot written to {args.plot}")

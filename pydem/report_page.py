@@ -34,8 +34,8 @@ def write_page(out: Path, title: str, sections: list[tuple[str, str, str]], plot
     imgs = "".join(f"<figure><img alt='{n}' src='data:image/png;base64,{base64.b64encode(p).decode()}'></figure>"
                    for n, p in plots.items())
     page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>"
-            "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
-            "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
+            "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;overflow-wrap:anywhere}"
+            "table{border-collapse:collapse;margin:.5em 0;display:block;overflow-x:auto;max-width:100%}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
             ".verdict{font-size:1.2em;background:#f4f4f0;padding:.6em}img{max-width:100%}</style></head><body>"
             f"<h1>{html.escape(title)}</h1>" + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[:head])
             + imgs + "".join(f"<h2>{html.escape(t)}</h2>{h}" for t, _, h in sections[head:]) + "</body></html>")

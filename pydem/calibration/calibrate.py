@@ -24,6 +24,8 @@ from ..mlp import NativeMLP
 from .candidates import Candidate
 from .fit import Fit, Model, fit_own_noise, posterior
 from .quantities import Observation
+from .reach import held_back
+from .verdicts import calibration_verdict
 
 
 @dataclass
@@ -34,6 +36,11 @@ class Calibration:
     fit: Fit                       # best fit, with its posterior
     screening: dict                # seed 000's admissible set: window, samples, admissible, ranges, seconds
     notes: list[str] = field(default_factory=list)
+    reach: list[dict] = field(default_factory=list)  # parameters held back by the campaign box (reach.py)
+
+    @property
+    def verdict(self) -> str:
+        return calibration_verdict(self.fit.n, len(self.fit.names), self.fit.p_value, self.reach)
 
     def residual_table(self) -> list[dict]:
         return residual_table(self.observations, self.model, self.fit)
@@ -43,7 +50,7 @@ class Calibration:
 
     def as_dict(self) -> dict:
         post = self.fit.posterior
-        return {"material": self.material, "fit": self.summary(),
+        return {"material": self.material, "verdict": self.verdict, "reach": self.reach, "fit": self.summary(),
                 "parameters": {n: dict(p) for n, p in post.get("parameters", {}).items()},
                 "correlation": {"names": post.get("names"), "matrix": post.get("correlation")},
                 "posterior_samples": post.get("samples"), "posterior_ess": post.get("ess"),
@@ -158,9 +165,6 @@ def calibrate(material: str, observations: list[Observation], nets: dict, ranges
     say(f"  seed 000's view: {screening['admissible']:,} of {screening['samples']:,} combinations within "
         f"±{100 * window:g} % of every measured value ({screening['seconds']:.2f} s natively, {threads} threads)")
     notes = []
-    if fit.n <= len(fit.names):
-        notes.append(f"{fit.n} measurement(s) for {len(fit.names)} parameters: the posterior is the prior narrowed "
-                     f"along a few directions only; measure more conditions")
     for name, p in fit.posterior["parameters"].items():
         if p["at_edge"]:
             notes.append(f"{name} sits at the edge of its campaign range [{p['range'][0]:g}, {p['range'][1]:g}] "
@@ -169,4 +173,4 @@ def calibrate(material: str, observations: list[Observation], nets: dict, ranges
     if covered:
         notes.append("held at their neutral values: " + ", ".join(f"{c.name} ({c.parameter})" for c in covered))
     notes += row_notes(observations) + weak_surrogates(observations, nets)
-    return Calibration(material, observations, model, fit, screening, notes)
+    return Calibration(material, observations, model, fit, screening, notes, held_back(model, fit))

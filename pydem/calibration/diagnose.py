@@ -30,7 +30,12 @@ most ALPHA times the number of tests made (3 candidates: 3 + 2 + 1 tests, < 6 %;
 later steps are only reached after a first, significant effect). The intervals reported are
 those of the final model.
 
-Verdicts: `no_effect_needed` (no candidate significant at ALPHA and the base fit acceptable),
+Verdicts (the one vocabulary of `diagnose` and `calibrate`, docs/diagnosis.md §4):
+`not_testable` (no more measurements than base parameters: nothing could be tested),
+`out_of_reach` (the best fit stops at an edge of the campaign box where the misfit still falls
+outward, reach.py: the measurements lie past what the model reaches in the box — instead of a
+clean verdict, which it would otherwise overstate), `no_effect_needed` (no candidate significant
+at ALPHA and the base fit acceptable),
 `effect` (one candidate clearly best, and any further effects forward selection adds),
 `indistinguishable` (two or more significant with LRs within DELTA_TIE of each other),
 `unexplained` (the base fit is rejected and no candidate, or not even the best, brings the fit to
@@ -50,9 +55,10 @@ from .detectability import best_next_measurement, candidate_tests, detectable_ef
 from .calibrate import fit_base, fit_summary, residual_table, row_notes, weak_surrogates, window_screen
 from .fit import Fit, Model, fit_own_noise, minimise, posterior
 from .quantities import Observation, test_conditions
+from .reach import held_back
+from .verdicts import ACCEPT
 
 ALPHA = 0.01        # per-candidate significance (3 candidates: family-wise < 3 %)
-ACCEPT = 0.001      # a fit with chi^2 p-value below this is rejected
 OUTLIER_ALPHA = 0.001  # one row set aside as an outlier: its deletion test, Bonferroni over the rows ...
 CLEAN = 0.05           # ... and the fit without it clean (chi^2 p-value at least this), not merely accepted
 DELTA_TIE = 2.0     # LRs closer than this (a BIC difference < 2: "not worth a bare mention")
@@ -105,6 +111,7 @@ class Diagnosis:
     outliers: list[dict] = field(default_factory=list)  # rows set aside (outlier_screen), with why
     detectable: dict = field(default_factory=dict)  # per candidate: the smallest effect these rows would show
     added: list[CandidateResult] = field(default_factory=list)  # effects forward selection added after the first
+    reach: list[dict] = field(default_factory=list)  # the final fit's parameters held back by the box (reach.py)
 
     @property
     def effects(self) -> list[str]:
@@ -127,9 +134,10 @@ class Diagnosis:
         for name in final.names:
             p = post.get(name, {})
             params[name] = {"estimate": float(final.as_dict()[name]), "lo": p.get("lo"), "hi": p.get("hi"),
-                            "mean": p.get("mean"), "sd": p.get("sd"), "at_edge": p.get("at_edge")}
+                            "mean": p.get("mean"), "sd": p.get("sd"), "at_edge": p.get("at_edge"),
+                            "interval": p.get("interval")}
         return {"material": self.material, "verdict": self.verdict, "effect": self.effect, "effects": self.effects,
-                "added": [a.as_dict() for a in self.added], "testable": self.testable,
+                "added": [a.as_dict() for a in self.added], "testable": self.testable, "reach": self.reach,
                 "candidates": [c.as_dict() for c in self.candidates], "not_covered": self.not_covered,
                 "before": self.summary_of(self.base, self.base_model),
                 "after": self.summary_of(self.after, self.after_model),
@@ -359,7 +367,9 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
     separating = {}
     chosen = None
     added: list[CandidateResult] = []
-    if not sig:
+    if not testable:
+        verdict = "not_testable"
+    elif not sig:
         verdict = "no_effect_needed" if base.p_value >= ACCEPT else "unexplained"
     else:
         chosen = sig[0]
@@ -417,8 +427,11 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
                          f"[{p['range'][0]:g}, {p['range'][1]:g}] (estimate {p['estimate']:.4g}, 95 % interval "
                          f"{p['lo']:.4g}-{p['hi']:.4g})")
     final_model = after_model if after is not None else base_model
+    reach = held_back(final_model, after if after is not None else base)
+    if reach and verdict in ("no_effect_needed", "not_testable"):
+        verdict = "out_of_reach"  # "consistent" only because the box stops it: not a confirmation
     window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
                      after, after_model, similarity, separating, groups, loco, notes, testable, window,
-                     detectable=detectable, added=added if verdict == "effect" else [])
+                     detectable=detectable, added=added if verdict == "effect" else [], reach=reach)

@@ -12,16 +12,28 @@ from pathlib import Path
 from ..rigs.result import strict_json
 
 
-def card(material: str, setup, fit, candidates) -> dict:
+CLEAN_VERDICTS = ("calibrated", "no_effect_needed", "effect")
+
+
+def card(material: str, setup, fit, candidates, verdict: str, verdict_line: str) -> dict:
     """The parameters of a fitted model: the free ones at their estimates (with the posterior's
     95 % interval), the candidates not freed at their neutral values, and the solid and wall
-    constants the campaign stores hold fixed."""
+    constants the campaign stores hold fixed; with the report's verdict and the caveats that
+    qualify the numbers (a verdict that is not clean, estimates at a range edge, one-sided
+    intervals), which the LIGGGHTS and LAMMPS files repeat as comments above the numbers."""
     est = fit.as_dict()
     post = fit.posterior.get("parameters", {})
     values = {c.parameter: c.neutral_value(est) for c in candidates}
     values.update(est)
     store = next(iter(setup.stores.values()))
     fixed = store.spec.config({}).params  # the campaigns' solid and wall constants
+    caveats = [] if verdict in CLEAN_VERDICTS else [f"verdict {verdict}: {verdict_line}"]
+    for name, p in post.items():
+        if p.get("at_edge"):
+            caveats.append(f"{name} = {est[name]:.4g} sits at the edge of its campaign range {p['range']}: a bound, not "
+                           f"an estimate")
+        elif p.get("interval", "central") != "central":
+            caveats.append(f"{name}: its 95 % interval is {p['interval']} ({p['lo']:.4g}-{p['hi']:.4g})")
     params = {}
     for name, v in values.items():
         p = post.get(name, {})
@@ -29,7 +41,7 @@ def card(material: str, setup, fit, candidates) -> dict:
                         "calibrated": name in est}
     for name in ("youngs_modulus", "poisson_ratio", "density", "wall_restitution", "wall_rolling_friction"):
         params.setdefault(name, {"value": float(getattr(fixed, name)), "interval_95": None, "calibrated": False})
-    return {"material": material, "models": {"normal": "Hertz", "damping": "restitution-based (seed 000)",
+    return {"material": material, "verdict": verdict, "caveats": caveats, "models": {"normal": "Hertz", "damping": "restitution-based (seed 000)",
                                              "tangential": "Mindlin history, Coulomb cap", "rolling": fixed.rolling_model,
                                              "effects": sorted({c.name for c in candidates if c.parameter.startswith("effects.")})},
             "parameters": params, "units": "SI", "from_stores": {r: str(s.path) for r, s in setup.stores.items()}}
@@ -50,6 +62,7 @@ def liggghts(c: dict) -> str:
     def pair(pp, pw):  # 2 x 2, row-major: particle-particle, particle-wall, wall-particle, wall-wall
         return f"2 {pp:.6g} {pw:.6g} {pw:.6g} {pw:.6g}"
     lines = [f"# {c['material']}: calibrated by pydem (material_card.json has the intervals). Type 1: particles, 2: walls.",
+             *_caveat_lines(c),
              f"# solid density {_v(c, 'density'):.6g} kg/m^3: set it on the particles (e.g. create_atoms / fix insert)",
              f"fix m1 all property/global youngsModulus peratomtype {E:.6g} {E:.6g}",
              f"fix m2 all property/global poissonsRatio peratomtype {nu:.6g} {nu:.6g}",
@@ -74,6 +87,7 @@ def lammps(c: dict) -> str:
     E, nu = _v(c, "youngs_modulus"), _v(c, "poisson_ratio")
     kc = _v(c, "effects.cohesion_sjkr.cohesion_energy_density")
     lines = [f"# {c['material']}: calibrated by pydem (material_card.json has the intervals). Type 1: particles, 2: walls.",
+             *_caveat_lines(c),
              "# Nearest LAMMPS models: hertz/material with coeff_restitution damping and mindlin tangential are",
              "# libdem's; rolling sds is a spring-dashpot-slider with a constant stiffness k_roll, where libdem's EPSD2",
              "# uses k_t R*^2: k_roll below is that value for the given diameter (set it) and mean overlap 1e-3 d.",
@@ -89,6 +103,10 @@ def lammps(c: dict) -> str:
         lines.append(f"# cohesion: libdem's SJKR energy density {kc:.6g} J/m^3 has no LAMMPS granular model; "
                      "the nearest is the jkr normal model with a surface energy fitted to the same pull-off force")
     return "\n".join(lines + [""])
+
+
+def _caveat_lines(c: dict) -> list[str]:
+    return [f"# CAVEAT: {x}" for x in c.get("caveats", [])]
 
 
 def write(c: dict, out: str | Path) -> list[Path]:

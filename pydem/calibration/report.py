@@ -14,32 +14,42 @@ from .. import report_page as page
 from ..quantity_table import metric_spec
 from ..rigs.result import strict_json
 from .diagnose import ALPHA, Diagnosis
-
-VERDICT_TEXT = {
-    "no_effect_needed": "The base model is consistent with the measurements: no candidate effect is needed.",
-    "effect": "One missing effect explains the measurements significantly better than the base model: {effect}.",
-    "effects": "Missing effects explain the measurements significantly better than the base model, each on top of "
-               "the one before: {effects}.",
-    "indistinguishable": "Missing effects explain the measurements significantly better than the base model, but "
-                         "{effect} and {others} about equally well with these conditions.",
-    "unexplained": "The base model fails, and none of the candidate effects explains the misfit.",
-}
-
+from .reach import sentence as reach_sentence
+from .verdicts import ACCEPT, TEXT
 
 def verdict_line(d: Diagnosis) -> str:
     sig = [c.effect for c in d.candidates if c.p_value < ALPHA and c.effect != d.effect]
-    text = VERDICT_TEXT["effects" if d.verdict == "effect" and d.added else d.verdict]
-    line = text.format(effect=d.effect, others=", ".join(sig) or "another candidate", effects=" + ".join(d.effects))
-    if not d.testable:
-        line += (f" But with {len(d.observations)} measurement(s) for {len(d.base.names)} base parameters no candidate "
+    text = TEXT["effects" if d.verdict == "effect" and d.added else d.verdict]
+    line = text.format(effect=d.effect, others=", ".join(sig) or "another candidate", effects=" + ".join(d.effects),
+                       n=len(d.observations), k=len(d.base.names))
+    if d.reach:
+        line += " " + reach_sentence(d.reach)
+    if not d.testable and d.verdict != "not_testable":
+        line += (f" With {len(d.observations)} measurement(s) for {len(d.base.names)} base parameters no candidate "
                  f"effect could be tested: measure more conditions.")
     if d.verdict == "no_effect_needed" and d.detectable:
         hidden = [f"{name} {_limits(info)}" for name, info in d.detectable.items()]
         line += (" It does not rule out effects these measurements cannot show (below their 90 % detection limits): "
                  + "; ".join(hidden) + ".")
-    edges = [n for n, p in d.base.posterior.get("parameters", {}).items() if p.get("at_edge")]
+    final = d.after if d.after is not None else d.base
+    edges = [n for n, p in final.posterior.get("parameters", {}).items()
+             if p.get("at_edge") and n not in {r["parameter"] for r in d.reach}]
     if edges:
-        line += f" The base estimate sits at the edge of the campaign range for {', '.join(edges)}."
+        line += (f" The {'final' if d.after is not None else 'base'} model's estimate or interval reaches the edge of "
+                 f"the campaign range for {', '.join(edges)} (the misfit does not fall past it: a bound, not a "
+                 f"shortfall).")
+    return line
+
+
+def calibration_line(c) -> str:
+    """The calibration report's opening line: its verdict in words, and the caveats that qualify it."""
+    f = c.fit
+    line = TEXT[c.verdict].format(p=f.p_value, accept=ACCEPT, n=f.n, k=len(f.names))
+    if c.reach:
+        line += " " + reach_sentence(c.reach)
+    if f.n <= len(f.names) and c.verdict != "not_testable":
+        line += (f" With {f.n} measurement(s) for {len(f.names)} parameters the posterior is the prior narrowed along "
+                 f"a few directions only: measure more conditions.")
     return line
 
 
@@ -57,10 +67,14 @@ def _axis_condition(q) -> str | None:
     return {"ring-shear": "preshear_stress", "hopper": "slot_width"}.get(q.rig)
 
 
+MODEL_COLOURS = ("C0", "C3", "C2")  # base model blue, the model with the effect(s) red
+
+
 def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.ndarray]]) -> bytes:
-    """Measured (error bars: each row's stated uncertainty) and each model's predictions with a band
-    of +-1 sigma of measured - model at that model's estimate ({label: (values, sigma)}; the first
-    dashed, the others solid) against each quantity's condition, one panel per quantity. Each
+    """Measured (black, error bars: each row's stated uncertainty) and each model's predictions with a
+    band of +-1 sigma of measured - model at that model's estimate ({label: (values, sigma)}; one
+    colour per model, the first dashed; a quantity's series, e.g. its shear fractions, told apart
+    by marker) against each quantity's condition, one panel per quantity. Each
     model carries its own sigma: the seed scatter and the nets' error change with the parameters
     (a cohesive estimate scatters more), so a band drawn from the base model's sigma would misstate
     the fit with the effect."""
@@ -86,19 +100,20 @@ def plot_measured_vs_model(observations, models: dict[str, tuple[np.ndarray, np.
             order = np.argsort(x)
             x = x[order]
             ii = [ii[j] for j in order]
-            col = f"C{k}"
+            marker = "osD^v"[k % 5]
             u = [observations[i].uncertainty if observations[i].uncertainty_given else 0.0 for i in ii]
-            ax.errorbar(x, [observations[i].value for i in ii], yerr=u, fmt="o", color=col, capsize=3,
+            ax.errorbar(x, [observations[i].value for i in ii], yerr=u, fmt=marker, color="k", capsize=3,
                         label=f"measured {label}".strip(), zorder=3)
             for m, (name, (pred, sigma)) in enumerate(models.items()):
+                col = MODEL_COLOURS[m % len(MODEL_COLOURS)]
                 y, sd = pred[ii], sigma[ii]
                 xm = x if len(x) > 1 else x + 0.25 * (m + 1)  # one point: each model beside the measurement
-                ax.plot(xm, y, "--x" if m == 0 else "-+", color=col, alpha=0.8 if m == 0 else 1.0,
-                        ms=6 if m == 0 else 10, label=f"{name} {label}".strip())
+                ax.plot(xm, y, ("--" if m == 0 else "-") + marker, color=col, mfc="none", ms=6,
+                        label=f"{name} {label}".strip())
                 if len(x) > 1:
-                    ax.fill_between(x, y - sd, y + sd, color=col, alpha=0.08 if m == 0 else 0.18, lw=0)
+                    ax.fill_between(x, y - sd, y + sd, color=col, alpha=0.12, lw=0)
                 else:  # one point: the band as an error bar
-                    ax.errorbar(xm, y, yerr=sd, fmt="none", color=col, alpha=0.5 if m == 0 else 0.9, capsize=3)
+                    ax.errorbar(xm, y, yerr=sd, fmt="none", color=col, alpha=0.7, capsize=3)
         ax.set_title(q.key, fontsize=10)
         unit = metric_spec(q.metric).unit  # the one quantity table's
         ax.set_ylabel(q.metric.replace("_", " ") + (f" ({unit})" if unit else ""))
@@ -174,6 +189,8 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     if d.after is not None:
         models[f"with {d.effect or 'best candidate'}"] = (d.after_model.predict(d.after.best), d.after_model.sigma)
     out = {"residuals.png": plot_measured_vs_model(d.observations, models)}
+    if not d.candidates:  # no plot without bars: the candidates section says why
+        return out
     fig, ax = plt.subplots(figsize=(5.5, 0.5 + 0.45 * max(len(d.candidates), 1)))
     names = [c.effect for c in d.candidates][::-1]
     vals = [c.statistic for c in d.candidates][::-1]
@@ -183,8 +200,6 @@ def plot_residuals(d: Diagnosis) -> dict[str, bytes]:
     ax.axvline(float(stats.chi2.isf(ALPHA, 1)), color="k", ls="--", label=f"p = {ALPHA:g}, two-sided")
     ax.set_xlabel("profile-likelihood ratio (chi^2 base - chi^2 with the effect)")
     ax.legend(fontsize=7)
-    if not names:
-        ax.text(0.5, 0.5, "no candidate covered by these campaigns", ha="center", transform=ax.transAxes)
     out["candidates.png"] = page.png(fig)
     return out
 
@@ -235,6 +250,10 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
                   f"{_g(a.estimate_hi)}) — added (p < {ALPHA:g}, the same level as the first step).")
     if d.not_covered:
         extra = f"\n\nNot covered by these campaigns: {', '.join(d.not_covered)}."
+    if not d.candidates:
+        extra += (f"\n\nNo candidate effect was tested: {len(d.observations)} measurement(s) for {len(d.base.names)} "
+                  f"base parameters leave nothing to test with." if not d.testable else
+                  "\n\nNo candidate effect was tested: none is varied by the campaigns of these measurements.")
     sims = "; ".join(f"{k.replace('|', ' vs ')}: {v:.2f}" for k, v in d.similarity.items())
     if sims:
         extra += f"\n\nCosine of the candidates' projected signatures (1: these conditions cannot tell them apart): {sims}."
@@ -261,6 +280,8 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
         sections.append(confirm_section(data["context"]["confirm"]))
     if d.notes:
         sections.append(notes_section(d.notes))
+    sections.append(glossary_section(DIAGNOSIS_TERMS))
+    sections.append(provenance_section(data["context"]))
     return page.write_page(out, f"Diagnosis: {d.material}", sections, plots, head=2)
 
 
@@ -291,9 +312,16 @@ def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
 
 
 def parameter_section(params: dict, window: dict | None, title: str) -> tuple[str, str, str]:
-    rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}", _g(v["sd"]), "yes" if v["at_edge"] else ""]
-            for k, v in params.items()]
-    md, h = page.table(rows, ["parameter", "estimate", "95 % credible interval", "posterior sd", "at range edge"])
+    rows = [[k, _g(v["estimate"]), f"{_g(v['lo'])} – {_g(v['hi'])}"
+             + ("" if v.get("interval", "central") == "central" else f" ({v['interval']})"), _g(v["sd"]),
+             "yes" if v["at_edge"] else ""] for k, v in params.items()]
+    md, h = page.table(rows, ["parameter", "most probable value", "95 % credible interval", "posterior sd",
+                              "at range edge"])
+    line = ("The most probable value is the best fit (the posterior's mode for a uniform prior on the campaign box); "
+            "the interval holds 95 % of the posterior, central, or from the range's edge when the posterior piles "
+            "against it and the most probable value lies outside the central one.")
+    md += "\n\n" + line
+    h += f"<p>{html.escape(line)}</p>"
     if window:
         line = (f"Seed 000's view: {window['admissible']:,} of {window['samples']:,} combinations of the box (scrambled "
                 f"Sobol, screened natively) predict every measured value within ±{100 * window['window']:g} %"
@@ -315,6 +343,59 @@ def confirm_section(rows: list[dict]) -> tuple[str, str, str]:
     table = [[r["label"], _g(r["measured"]), _g(r["dem"]), f"{100 * r['relative']:+.1f} %"] for r in rows]
     md, h = page.table(table, ["measurement", "measured", "DEM at the estimate", "(measured - DEM) / measured"])
     return "Confirming DEM runs", md, h
+
+
+COMMON_TERMS = {
+    "chi^2, chi^2/dof": "the sum of squared residuals, each in units of its row's sigma (rows correlated where their "
+                        "noise is shared); per degree of freedom (rows minus fitted parameters) it is about 1 when the "
+                        "model fits as well as the noise allows.",
+    "p-value (of a fit)": "the chance of a chi^2 at least this large if the model were right; below 0.001 the fit is "
+                          "rejected.",
+    "sigma, z": "a row's standard deviation of measured minus model: the measurement's uncertainty (or one rig run's "
+                "seed scatter where none is stated, and both for a DEM-made row) and the surrogate's error; z is the "
+                "residual in these units.",
+    "surrogate": "the small neural network that stands in for the DEM rig, trained on a campaign store's runs; its "
+                 "cross-validated error enters sigma.",
+}
+DIAGNOSIS_TERMS = COMMON_TERMS | {
+    "LR (likelihood ratio)": "how much chi^2 falls when a candidate's parameter is freed and every parameter refitted, "
+                             "both fits with one noise model (the base model's): under the base model it is chi^2 with "
+                             "1 degree of freedom, so a large LR is evidence for the effect.",
+    "p-value (of a candidate)": "the chance of an LR at least this large if the effect were absent; an effect is named "
+                                f"below {ALPHA:g} (one-sided candidates such as cohesion: half the two-sided value).",
+    "dBIC": "the change of the Bayesian information criterion when the effect is added (negative favours it; below -2 "
+            "worth a mention, below -10 strong).",
+    "score": "the same test taken as a slope at the neutral value (no refit): quick, but it understates strong effects; "
+             "the verdict uses LR.",
+    "projected signature, cosine": "how a candidate moves the predictions once the base parameters have re-adjusted; "
+                                   "two candidates whose signatures have a cosine near 1 cannot be told apart with "
+                                   "these conditions.",
+    "detection limit": "the smallest effect these measurements would show with 90 % probability at the test's level.",
+    "leave-one-condition-out RMSE": "the relative error of predicting each condition's rows from a fit without them.",
+}
+CALIBRATION_TERMS = COMMON_TERMS | {
+    "admissible set (seed 000's view)": "the combinations of the box whose predictions lie within the window of every "
+                                        "measured value, screened over scrambled Sobol points.",
+}
+
+
+def glossary_section(terms: dict) -> tuple[str, str, str]:
+    return ("What the numbers mean", "\n".join(f"- **{k}**: {v}" for k, v in terms.items()),
+            "<ul>" + "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(v)}</li>" for k, v in terms.items()) + "</ul>")
+
+
+def provenance_section(context: dict) -> tuple[str, str, str]:
+    """What made this report: pydem, libdem, commit, machine, command, time, the measurement file and
+    every store (its path, runs and the libdem that ran them)."""
+    prov = dict(context.get("provenance", {}))
+    rows = [[k, str(v)] for k, v in prov.items()]
+    if context.get("measurements"):
+        rows.append(["measurement file", context["measurements"]])
+    for rig, s in (context.get("stores") or {}).items():
+        rows.append([f"store ({rig})", f"{s['path']} (made by commit {s.get('commit')}, libdem {s.get('libdem')})"
+                     + (f"; pooled: {', '.join(s['pooled'])}" if s.get("pooled") else "")])
+    md, h = page.table(rows, ["item", "value"])
+    return "Provenance", md, h
 
 
 def notes_section(notes: list[str]) -> tuple[str, str, str]:
@@ -342,9 +423,10 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
     f = data["fit"]
     line = (f"chi^2/dof {f['chi2_per_dof']:.2f} over {f['n']} measurements ({f['dof']} dof, p = {_g(f['p_value'], '.2g')}), "
             f"RMSE of relative residuals {f['rmse_relative']:.3f}.")
-    if f["p_value"] < 0.001:
-        line += " The model does not fit these measurements: run `pydem diagnose` to find which effect is missing."
-    sections = [("Fit", line, f"<p class='verdict'>{html.escape(line)}</p>"),
+    verdict = calibration_line(c)
+    sections = [("Verdict", f"**{c.verdict}** — {verdict}", f"<p class='verdict'><b>{c.verdict}</b> — "
+                 f"{html.escape(verdict)}</p>"),
+                ("Fit", line, f"<p>{html.escape(line)}</p>"),
                 parameter_section(data["parameters"], data["admissible_window"], "Parameters (posterior)"),
                 residual_section(data["residuals"], "Residuals")]
     sections.append(nets_section({o.quantity: n for o, n in zip(c.observations, c.model.nets)}))
@@ -357,4 +439,6 @@ def write_calibration(c, out: str | Path, context: dict | None = None) -> Path:
         sections.append(confirm_section(data["context"]["confirm"]))
     if c.notes:
         sections.append(notes_section(c.notes))
-    return page.write_page(out, f"Calibration: {c.material}", sections, plots, head=2)
+    sections.append(glossary_section(CALIBRATION_TERMS))
+    sections.append(provenance_section(data["context"]))
+    return page.write_page(out, f"Calibration: {c.material}", sections, plots, head=3)

@@ -27,6 +27,7 @@ from .confirm import rig_values
 from .diagnose import diagnose
 from .fit import condition_correlation, scatter_correlations
 from .quantities import Observation, Quantity, test_conditions
+from .verdicts import ALARMS
 
 
 
@@ -284,8 +285,9 @@ def score_sets(results: list[dict]) -> dict:
     for kind, rows in sorted(by.items()):
         n = len(rows)
         if kind == "null":
-            out[kind] = {"sets": n, "false_alarms": sum(r["verdict"] != "no_effect_needed" for r in rows),
-                         "false_alarm_rate": sum(r["verdict"] != "no_effect_needed" for r in rows) / n}
+            alarms = sum(r["verdict"] in ALARMS for r in rows)
+            out[kind] = {"sets": n, "false_alarms": alarms, "false_alarm_rate": alarms / n,
+                         "out_of_reach": sum(r["verdict"] == "out_of_reach" for r in rows)}
         elif kind == "unexplained":
             out[kind] = {"sets": n, "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})}}
         else:

@@ -11,7 +11,11 @@ is the least-squares line through the shear points.
 - flow function ffc = sigma_1 / sigma_c (inf for a cohesionless locus);
 - effective angle of internal friction phi_e: the line through the origin tangent to that circle,
   sin(phi_e) = r / p;
-- steady-state flow angle phi_sf = atan(tau_pre / sigma_pre)."""
+- steady-state flow angle phi_sf = atan(tau_pre / sigma_pre);
+- Jenike's flowability class of ffc (flowability).
+
+Loci of one material (the rig's configuration but for the consolidation stress) make one flow
+function; loci of different materials are never joined (Locus.material)."""
 from __future__ import annotations
 
 import math
@@ -67,14 +71,29 @@ def evaluate(sigma_pre: float, tau_pre: float, sigma, tau) -> LocusResult:
                        math.degrees(math.asin(min(r / p, 1.0))), math.degrees(math.atan2(tau_pre, sigma_pre)), p, r)
 
 
+# Jenike's classes of the flow function ffc (Schulze, Powders and Bulk Solids, §3.3): lower bounds
+FLOWABILITY = ((10.0, "free-flowing"), (4.0, "easy-flowing"), (2.0, "cohesive"), (1.0, "very cohesive"),
+               (-math.inf, "not flowing"))
+# a rig configuration's keys that set the test's conditions, not the material
+CONDITION_KEYS = {"preshear_stress", "shear_points", "seed"}
+
+
+def flowability(ffc: float) -> str:
+    """Jenike's class of a flow function value: ffc < 1 not flowing, 1-2 very cohesive, 2-4
+    cohesive, 4-10 easy-flowing, >= 10 free-flowing (a cohesionless locus: ffc infinite)."""
+    return next(name for bound, name in FLOWABILITY if ffc >= bound)
+
+
 @dataclass
 class Locus:
-    """One yield locus as measured: the pre-shear point and the shear points."""
+    """One yield locus as measured: the pre-shear point and the shear points, and the material's
+    identity (the rig's configuration without its conditions; "" when the result does not say)."""
     label: str
     sigma_pre: float
     tau_pre: float
     sigma: list
     tau: list
+    material: str = ""
 
     @classmethod
     def from_result(cls, data: dict, label: str = "") -> "Locus":
@@ -85,8 +104,10 @@ class Locus:
         if len({p["fraction"] for p in pts}) < 2:
             raise ValueError(f"{label or 'result'}: a yield locus needs shear points at two or more fractions "
                              f"(run with --set shear_points=[0.4,0.6,0.8])")
+        config = data.get("provenance", {}).get("config", {})
+        material = ", ".join(f"{k}={v}" for k, v in sorted(config.items()) if k not in CONDITION_KEYS)
         return cls(label, float(m["sigma_preshear"]["value"]), float(m["tau_preshear"]["value"]),
-                   [p["sigma"] for p in pts], [p["tau_peak"] for p in pts])
+                   [p["sigma"] for p in pts], [p["tau_peak"] for p in pts], material)
 
     def evaluate(self) -> LocusResult:
         return evaluate(self.sigma_pre, self.tau_pre, self.sigma, self.tau)
@@ -94,8 +115,8 @@ class Locus:
 
 def plot_loci(loci: list[Locus], path) -> None:
     """Left: each locus — shear points, pre-shear point, the linearised locus, the consolidation
-    Mohr circle (sigma_1) and the unconfined-yield circle (sigma_c). Right: the flow function
-    sigma_c(sigma_1) with Jenike's ffc = 1, 2, 4, 10 lines."""
+    Mohr circle (sigma_1) and the unconfined-yield circle (sigma_c). Right: one flow function
+    sigma_c(sigma_1) per material (Locus.material), with Jenike's ffc = 1, 2, 4, 10 lines."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -125,7 +146,13 @@ def plot_loci(loci: list[Locus], path) -> None:
     for ffc in (1, 2, 4, 10):
         af.plot([0, top], [0, top / ffc], color="0.7", lw=0.8)
         af.text(top, top / ffc, f"ffc = {ffc}", fontsize=7, color="0.4", va="center")
-    af.plot(s1s, scs, "o-", color="k")
+    materials = list(dict.fromkeys(lc.material for lc in loci))
+    for m, material in enumerate(materials):
+        pts = sorted((s1, sc) for s1, sc, lc in zip(s1s, scs, loci) if lc.material == material)
+        name = f"material {m + 1}" if len(materials) > 1 else "flow function"
+        af.plot(*zip(*pts), "o-", color="k" if len(materials) == 1 else f"C{m}", label=name)
+    if len(materials) > 1:
+        af.legend(fontsize=7)
     af.set_xlabel("major consolidation stress sigma_1 (Pa)")
     af.set_ylabel("unconfined yield strength sigma_c (Pa)")
     af.set_xlim(0, top * 1.15)

@@ -81,7 +81,11 @@ def test_one_angle_for_three_parameters_gives_a_ridge_not_an_error(tiny):
     widths = {n: (p["hi"] - p["lo"]) / (hi - lo) for n, p, lo, hi in
               zip(fit.names, post["parameters"].values(), model.lo, model.hi)}
     assert post["ess"] > 50
-    assert max(widths.values()) > 0.6, widths  # some direction stays nearly as wide as the box
+    # some direction stays wide: over half the box (the best fit sits in a corner, so each interval
+    # runs one-sided from the edge it sits at; the central intervals were 0.6-0.9 of the box)
+    assert max(widths.values()) > 0.5, widths
+    for p in post["parameters"].values():  # and every estimate lies inside its own interval
+        assert p["lo"] <= p["estimate"] <= p["hi"], p
 
 
 def test_calibrate_command_writes_report_nets_and_window(tiny, tmp_path):

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from pydem.rigs.yield_locus import evaluate
+from pydem.rigs.yield_locus import evaluate, flowability
 
 
 def test_hand_worked_locus():
@@ -31,6 +31,14 @@ def test_hand_worked_locus():
     assert res.phi_e == pytest.approx(math.degrees(math.asin(r / 3000.0)), rel=1e-9)
     assert res.phi_e == pytest.approx(40.116, abs=1e-3)
     assert res.phi_sf == pytest.approx(39.595, abs=1e-3)
+
+
+def test_jenike_classes():
+    """Jenike's classes at and between their bounds (Schulze §3.3): <1 not flowing, 1-2 very
+    cohesive, 2-4 cohesive, 4-10 easy-flowing, >=10 free-flowing (a cohesionless locus: inf)."""
+    got = [flowability(x) for x in (0.5, 1.0, 1.9, 2.0, 3.9, 4.0, 9.99, 10.0, math.inf)]
+    assert got == ["not flowing", "very cohesive", "very cohesive", "cohesive", "cohesive", "easy-flowing",
+                   "easy-flowing", "free-flowing", "free-flowing"]
 
 
 def test_cohesionless_locus_and_bad_input():
@@ -111,10 +119,20 @@ def test_pydem_locus_reports_and_plots_several_loci(tmp_path):
     assert out.returncode == 0, out.stderr
     rows = {line.split("|")[1].strip(): [x.strip() for x in line.split("|")[2:-1]] for line in out.stdout.splitlines()
             if line.startswith("| a ") or line.startswith("| b ")}
-    assert float(rows["a"][1]) == pytest.approx(4933.01, abs=1.5) and rows["a"][2:4] == ["1732", "2.85"]  # by hand
-    assert rows["a"][4] == "40.1" and rows["a"][5] == "30.0" and rows["a"][7] == "500"
-    assert float(rows["b"][2]) == pytest.approx(2 * 800 * math.cos(math.radians(30)) / 0.5, abs=1)  # sigma_c
+    assert float(rows["a"][2]) == pytest.approx(4933.01, abs=1.5) and rows["a"][3:5] == ["1732", "2.85"]  # by hand
+    assert rows["a"][5] == "cohesive"  # Jenike: 2 <= ffc < 4
+    assert rows["a"][6] == "40.1" and rows["a"][7] == "30.0" and rows["a"][9] == "500"
+    assert float(rows["b"][3]) == pytest.approx(2 * 800 * math.cos(math.radians(30)) / 0.5, abs=1)  # sigma_c
+    assert rows["a"][0] == rows["b"][0] == "1"  # neither result names its material: one flow function
     assert (tmp_path / "loci.png").stat().st_size > 20_000
+    # two materials (different friction in the results' configurations): two flow functions, never joined
+    for name, friction in (("a", 0.5), ("b", 0.3)):
+        d = json.loads((tmp_path / f"{name}.json").read_text())
+        d["provenance"] = {"config": {"friction": friction, "preshear_stress": d["metrics"]["sigma_preshear"]["value"]}}
+        (tmp_path / f"{name}.json").write_text(json.dumps(d))
+    out = subprocess.run([sys.executable, "-m", "pydem", "locus", str(tmp_path / "a.json"), str(tmp_path / "b.json")],
+                         cwd=root, capture_output=True, text=True)
+    assert out.returncode == 0 and "2: friction=0.3" in out.stdout and "1: friction=0.5" in out.stdout, out.stdout
     bad = subprocess.run([sys.executable, "-m", "pydem", "locus", str(tmp_path / "loci.png")], cwd=root,
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "loci.png: not a ring-shear result file" in bad.stderr

@@ -1,0 +1,78 @@
+"""Is a best fit held back by the campaign box? A parameter whose estimate sits at an edge of its
+range, where χ² still falls outward, marks measurements the model cannot reach inside the box:
+the verdict is then `out_of_reach` (docs/diagnosis.md §4), not "consistent" — a model that fits
+only because the row's σ is wide, or that would fit better past the box, is not confirmed by it.
+
+The test is linear at the best fit, in whitened units (fit.Model): g = J_j' M r, the score of
+parameter j with the other parameters that are inside their ranges re-adjusted (M takes out what
+they can absorb, each at a cost of chi^2 1 per box width moved). χ² falls outward when g points out of the box; freeing j past the edge would lower χ² by
+g² / (J_j' M J_j) to first order. An edge counts when that gain is at least REACH_CHI2 (one σ's
+worth): a gain below it is within what the noise moves."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..quantity_table import metric_spec
+from .fit import Fit, Model
+
+EDGE = 0.01        # an estimate within this fraction of its range's width of an edge sits at it
+REACH_CHI2 = 1.0   # the linearised chi^2 gain past the edge that makes it "out of reach"
+
+
+def held_back(model: Model, fit: Fit) -> list[dict]:
+    """Per parameter at an edge with chi^2 falling outward by at least REACH_CHI2: its name, the
+    edge ('lower'/'upper') and its value, the gain, and the row the model misses most (label,
+    measured, model, residual in the quantity's unit and in sigma)."""
+    p = fit.best
+    width = model.hi - model.lo
+    at_lo = p - model.lo <= EDGE * width
+    at_hi = model.hi - p <= EDGE * width
+    if not (at_lo.any() or at_hi.any()):
+        return []
+    pred = model.predict(p)
+    r = model.white(model.y - pred)
+    J = model.white(model.jacobian(p))
+    inside = ~(at_lo | at_hi)
+    Ji = J[:, inside]
+    # M: what the inside parameters cannot re-adjust; each costs chi^2 1 per box width moved (the
+    # posterior's proposal does the same), so a parameter with no local slope (friction at the
+    # angle of repose's maximum) does not absorb a whole row by a huge linearised step
+    D = np.diag(1.0 / width[inside] ** 2)
+    M = np.eye(len(r)) - Ji @ np.linalg.solve(Ji.T @ Ji + D, Ji.T) if Ji.shape[1] else np.eye(len(r))
+    out = []
+    for j, name in enumerate(model.free):
+        if inside[j]:
+            continue
+        info = float(J[:, j] @ M @ J[:, j])
+        if info <= 0:
+            continue
+        g = float(J[:, j] @ M @ r)  # chi^2 falls along +g (d chi^2 / d theta_j = -2 g)
+        if not ((at_hi[j] and g > 0) or (at_lo[j] and g < 0)):
+            continue
+        gain = g * g / info
+        if gain < REACH_CHI2:
+            continue
+        z = (model.y - pred) / model.sigma
+        k = int(np.argmax(np.abs(z)))
+        out.append({"parameter": name, "edge": "upper" if at_hi[j] else "lower",
+                    "value": float(model.hi[j] if at_hi[j] else model.lo[j]), "gain": gain,
+                    "row": {"label": model.obs[k].label, "measured": float(model.y[k]), "model": float(pred[k]),
+                            "residual": float(model.y[k] - pred[k]), "z": float(z[k]),
+                            "unit": metric_spec(model.obs[k].quantity.metric).unit}})
+    return out
+
+
+def sentence(reach: list[dict]) -> str:
+    """The plain-words account of held_back's list: how far, and what could reach it."""
+    if not reach:
+        return ""
+    row = reach[0]["row"]
+    unit = row["unit"]
+    edges = ", ".join(f"{r['parameter'].split('.')[-1]} at its {r['edge']} edge {r['value']:g}" for r in reach)
+    past = " or ".join(f"{'above' if r['edge'] == 'upper' else 'below'} {r['value']:g} for "
+                       f"{r['parameter'].split('.')[-1]}" for r in reach)
+    return (f"The best fit inside the campaign box stops at {edges}, and the misfit falls past it (χ² by "
+            f"{max(r['gain'] for r in reach):.1f} to first order): {row['label']} measured {row['measured']:.4g}, "
+            f"the model reaches {row['model']:.4g} ({row['residual']:+.3g}{(' ' + unit) if unit else ''}, "
+            f"{row['z']:+.1f} σ). A campaign whose range goes {past}, or an effect that moves this quantity, could "
+            f"reach it; within this box the parameters are bounds, not estimates.")
