@@ -427,9 +427,13 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
                          f"[{p['range'][0]:g}, {p['range'][1]:g}] (estimate {p['estimate']:.4g}, 95 % interval "
                          f"{p['lo']:.4g}-{p['hi']:.4g})")
     final_model = after_model if after is not None else base_model
-    reach = held_back(final_model, after if after is not None else base)
+    final_fit = after if after is not None else base
+    reach = held_back(final_model, final_fit)
     if reach and verdict in ("no_effect_needed", "not_testable"):
         verdict = "out_of_reach"  # "consistent" only because the box stops it: not a confirmation
+    elif reach and verdict == "unexplained" and final_fit.dof > 0 and stats.chi2.sf(
+            max(final_fit.chi2 - max(r["gain"] for r in reach), 0.0), final_fit.dof) >= ACCEPT:
+        verdict = "out_of_reach"  # the misfit is what the edge holds back: past it the fit would pass
     window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,

@@ -3,14 +3,15 @@ range, where χ² still falls outward, marks measurements the model cannot reach
 the verdict is then `out_of_reach` (docs/diagnosis.md §4), not "consistent" — a model that fits
 only because the row's σ is wide, or that would fit better past the box, is not confirmed by it.
 
-The test is linear at the best fit, in whitened units (fit.Model): g = J_j' M r, the score of
-parameter j with the other parameters that are inside their ranges re-adjusted (M takes out what
-they can absorb, each at a cost of chi^2 1 per box width moved). χ² falls outward when g points out of the box; freeing j past the edge would lower χ² by
-g² / (J_j' M J_j) to first order. An edge counts when that gain is at least REACH_CHI2 (one σ's
-worth): a gain below it is within what the noise moves."""
+The test is linear at the best fit, in whitened units (fit.Model): the chi^2 drop when parameter j
+may step outward past its edge and the others re-adjust inside the box (one at an edge only
+inward), each of them at a cost of chi^2 1 per box width moved — a bounded linear least-squares
+problem. An edge counts when that gain is at least REACH_CHI2 (one σ's worth): a gain below it is
+within what the noise moves."""
 from __future__ import annotations
 
 import numpy as np
+from scipy import optimize
 
 from ..quantity_table import metric_spec
 from .fit import Fit, Model
@@ -32,33 +33,34 @@ def held_back(model: Model, fit: Fit) -> list[dict]:
     pred = model.predict(p)
     r = model.white(model.y - pred)
     J = model.white(model.jacobian(p))
-    inside = ~(at_lo | at_hi)
-    Ji = J[:, inside]
-    # M: what the inside parameters cannot re-adjust; each costs chi^2 1 per box width moved (the
-    # posterior's proposal does the same), so a parameter with no local slope (friction at the
-    # angle of repose's maximum) does not absorb a whole row by a huge linearised step
-    D = np.diag(1.0 / width[inside] ** 2)
-    M = np.eye(len(r)) - Ji @ np.linalg.solve(Ji.T @ Ji + D, Ji.T) if Ji.shape[1] else np.eye(len(r))
+    k = len(model.free)
+    # the other parameters re-adjust, inside the box: one at an edge only inward (freeing j can let it
+    # back in, never past its own edge); each costs chi^2 1 per box width moved (as the posterior's
+    # proposal), so a parameter with no local slope (friction at the angle of repose's maximum)
+    # does not absorb a whole row by a huge linearised step
+    inward_lo = np.where(at_lo, 0.0, -np.inf)
+    inward_hi = np.where(at_hi, 0.0, np.inf)
+    A = np.vstack([J, np.diag(1.0 / width)])
+    b = np.concatenate([r, np.zeros(k)])
     out = []
     for j, name in enumerate(model.free):
-        if inside[j]:
+        if not (at_lo[j] or at_hi[j]):
             continue
-        info = float(J[:, j] @ M @ J[:, j])
-        if info <= 0:
-            continue
-        g = float(J[:, j] @ M @ r)  # chi^2 falls along +g (d chi^2 / d theta_j = -2 g)
-        if not ((at_hi[j] and g > 0) or (at_lo[j] and g < 0)):
-            continue
-        gain = g * g / info
-        if gain < REACH_CHI2:
+        lo, hi = inward_lo.copy(), inward_hi.copy()
+        lo[j], hi[j] = (0.0, np.inf) if at_hi[j] else (-np.inf, 0.0)  # j: outward only, and free of cost
+        Aj = A.copy()
+        Aj[len(r) + j] = 0.0
+        step = optimize.lsq_linear(Aj, b, bounds=(lo, hi)).x
+        gain = float(r @ r - np.sum((b - Aj @ step) ** 2))
+        if abs(step[j]) <= 0 or gain < REACH_CHI2:
             continue
         z = (model.y - pred) / model.sigma
-        k = int(np.argmax(np.abs(z)))
+        worst = int(np.argmax(np.abs(z)))
         out.append({"parameter": name, "edge": "upper" if at_hi[j] else "lower",
                     "value": float(model.hi[j] if at_hi[j] else model.lo[j]), "gain": gain,
-                    "row": {"label": model.obs[k].label, "measured": float(model.y[k]), "model": float(pred[k]),
-                            "residual": float(model.y[k] - pred[k]), "z": float(z[k]),
-                            "unit": metric_spec(model.obs[k].quantity.metric).unit}})
+                    "row": {"label": model.obs[worst].label, "measured": float(model.y[worst]),
+                            "model": float(pred[worst]), "residual": float(model.y[worst] - pred[worst]),
+                            "z": float(z[worst]), "unit": metric_spec(model.obs[worst].quantity.metric).unit}})
     return out
 
 

@@ -604,3 +604,27 @@ def test_a_null_with_a_varying_noise_model_keeps_the_false_alarm_rate():
         for c in d.candidates:  # both chi^2 with the base model's noise model
             assert c.statistic == pytest.approx(max(d.base.chi2 - c.fit.chi2, 0.0), abs=1e-9)
     assert false_alarms <= 3, false_alarms
+
+
+def test_measurements_past_the_box_are_out_of_reach_not_consistent():
+    """A material whose friction (1.08) lies past the campaign box's edge (1.0): the best fit stops
+    at the edge (chi^2/dof 1.2, no candidate significant) and the verdict says so (`out_of_reach`,
+    naming friction's upper edge) instead of a clean `no_effect_needed`. In this linear world the
+    linearised gain past the edge is the chi^2 drop when the box is widened (less the
+    1-per-box-width cost of re-adjusting the others): within 10 %. Three rows for three base
+    parameters: `not_testable`, never `no_effect_needed`."""
+    nets, obs = world()
+    data = generate(nets, obs, (1.08, 0.5, 0.5), {}, np.random.default_rng(12))
+    d = dg.diagnose("past", data, nets, RANGES, CANDS, say=lambda *a: None, detection_limits=False)
+    assert d.verdict == "out_of_reach" and [(r["parameter"], r["edge"]) for r in d.reach] == [("friction", "upper")]
+    wide = dict(RANGES, friction=(0.0, 2.0))
+    free = minimise(Model(data, nets, wide, CANDS, at=d.base.best), start=d.base.best)
+    drop = Model(data, nets, RANGES, CANDS, at=d.base.best).chi2(d.base.best) - free.chi2
+    assert free.best[0] > 1.03 and d.reach[0]["gain"] == pytest.approx(drop, rel=0.1), (d.reach, drop)
+    from pydem.calibration.report import verdict_line
+    assert "friction at its upper edge 1" in verdict_line(d)
+
+    three = [o for o in generate(nets, obs, (0.4, 0.5, 0.5), {}, np.random.default_rng(13))
+             if o.conditions["condition"] == 0.5]
+    d = dg.diagnose("three", three, nets, RANGES, CANDS, say=lambda *a: None, detection_limits=False)
+    assert d.verdict == "not_testable" and not d.testable
