@@ -39,8 +39,8 @@ at ALPHA and the base fit acceptable),
 `effect` (one candidate clearly best, and any further effects forward selection adds),
 `indistinguishable` (two or more significant with LRs within DELTA_TIE of each other),
 `unexplained` (the base fit is rejected and no candidate, or not even the best, brings the fit to
-an acceptable level — judged with the noise model its test used, so the chi^2 that decides is the
-one the report prints beside the LR). An `unexplained` that one row alone
+an acceptable level — the final model judged with its own noise model, the one at the truth if
+it is right; the report prints that chi^2/dof beside the test's). An `unexplained` that one row alone
 causes (a rig or lab outlier) is diagnosed again without that row, which is reported
 (outlier_screen)."""
 from __future__ import annotations
@@ -400,14 +400,15 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
         for r in [chosen] + added:  # every added effect's estimate and interval: the final model's
             p = after.posterior["parameters"][r.parameter]
             r.estimate, r.estimate_lo, r.estimate_hi = p["estimate"], p["lo"], p["hi"]
-        # accepted or not with the noise model its test used (the fit whose chi^2 the report prints as
-        # "chi^2 with it"): judged with the noise model where it lands, a model can pass by moving to
-        # where the error models say the runs scatter more (a density mismatch: chi^2/dof 25.5 -> 1.9)
-        judged = (added[-1] if added else chosen).fit
-        if judged.p_value < ACCEPT:
+        # the final model's goodness of fit, with its own noise model (the one at the truth if it is
+        # right). Judged with the tests' noise model instead (the base's), a density mismatch is
+        # unexplained in 14 of 15 surrogate sets rather than 12, but true effects whose material
+        # scatters more than the base point (a cohesive one) are rejected: top-1 falls from 28 / 24 to
+        # 23 / 17 of 30 for cohesion / wall friction (docs/diagnosis.md §7)
+        if after.p_value < ACCEPT:
             notes.append(f"adding {' and '.join([chosen.effect] + [a.effect for a in added])} lowers chi^2/dof from "
-                         f"{base.chi2_per_dof:.2f} to {judged.chi2_per_dof:.2f} (the tests' noise model), but the fit "
-                         f"is still rejected (p = {judged.p_value:.2g})")
+                         f"{base.chi2_per_dof:.2f} to {after.chi2_per_dof:.2f}, but the fit is still rejected "
+                         f"(p = {after.p_value:.2g})")
             verdict = "unexplained"
     loco = {"before": _loco(observations, nets, ranges, covered, None)}
     if chosen is not None:
