@@ -22,9 +22,26 @@ import numpy as np
 from .spec import CampaignSpec
 
 FORMAT = "pydem-campaign"
-FORMAT_VERSION = 2  # 2: `point` per run (replicates); version 1 stores read as one run per point
+FORMAT_VERSION = 3  # 3: per-dataset checksums; 2: `point` per run (replicates); 1: one run per point
+DATASETS = ("parameter_names", "parameters", "seed", "point", "status", "wall_seconds", "finished_at", "error",
+            "metric_names", "metric_units", "metrics", "metric_uncertainty")
 PENDING, DONE, FAILED = 0, 1, 2
 STATUS_NAMES = {PENDING: "pending", DONE: "done", FAILED: "failed"}
+
+
+def _checksums(f) -> dict[str, str]:
+    """SHA-256 (16 hex digits) of every dataset's content as read back, and of the attributes that
+    define the store: a flipped bit anywhere in them is found on open and named."""
+    import hashlib
+    out = {}
+    for name in DATASETS:
+        if name in f:
+            v = f[name][()]
+            data = json.dumps(_strings(f[name])).encode() if v.dtype == object else np.ascontiguousarray(v).tobytes()
+            out[name] = hashlib.sha256(f"{v.dtype.str} {v.shape}".encode() + data).hexdigest()[:16]
+    for key in ("spec", "provenance", "batches"):
+        out["attribute " + key] = hashlib.sha256(str(f.attrs[key]).encode()).hexdigest()[:16]
+    return out
 
 
 def _strings(dataset) -> list[str]:
@@ -227,6 +244,7 @@ class CampaignStore:
             f.create_dataset("metric_units", data=np.array(self.metric_units, dtype=object), dtype=h5py.string_dtype())
             f.create_dataset("metrics", data=self.values)
             f.create_dataset("metric_uncertainty", data=self.uncertainty)
+            f.attrs["checksums"] = json.dumps(_checksums(f))
             f.flush()
             os.fsync(f.id.get_vfd_handle())
         os.replace(tmp, self.path)
@@ -248,6 +266,13 @@ class CampaignStore:
                     raise StoreError(f"{path}: not a pydem campaign store (format attribute {f.attrs.get('format')!r})")
                 if int(f.attrs["format_version"]) > FORMAT_VERSION:
                     raise StoreError(f"{path}: store format {f.attrs['format_version']} is newer than this pydem reads")
+                if "checksums" in f.attrs:  # stores saved before format 3 have none
+                    stored, now = json.loads(f.attrs["checksums"]), _checksums(f)
+                    bad = [k for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
+                    if bad:
+                        raise StoreError(f"{path}: damaged store: {', '.join(bad)} no longer match(es) the checksum "
+                                         f"written with it (a flipped bit on disk or in a copy); restore it from a "
+                                         f"good copy")
                 s = cls(path, CampaignSpec.from_json(f.attrs["spec"]), json.loads(f.attrs["provenance"]))
                 s.batches = json.loads(f.attrs["batches"])
                 s.params = f["parameters"][()]

@@ -231,3 +231,27 @@ def test_status_states_throughput_and_time_left(tmp_path, monkeypatch):
     text = Campaign.open(tmp_path / "t.h5").status_text()
     assert "throughput: 36.0 runs/h" in text and "2 worker(s) of 1 thread(s)" in text
     assert "the 3 pending in about 0.1 h" in text  # 3 / 36 h
+
+
+def test_a_flipped_bit_in_a_store_is_refused_by_name(tmp_path):
+    """A store carries a checksum of every dataset (format 3): one byte flipped in a copy's run
+    times (a wall time of -92,474 s once trained silently) is refused on open, naming the
+    dataset; the intact copy opens. Stores from before format 3 (no checksums) still open."""
+    import h5py
+    ROOT = Path(__file__).resolve().parents[2]
+    old = CampaignStore.open(ROOT / "data/campaigns/aor_tiny.h5")
+    old.path = tmp_path / "sealed.h5"
+    old.save()
+    with h5py.File(old.path, "r") as f:
+        assert "checksums" in f.attrs and int(f.attrs["format_version"]) == 3
+        offset = f["wall_seconds"].id.get_offset()
+    good = CampaignStore.open(old.path)
+    assert np.array_equal(good.wall, old.wall) and np.array_equal(good.values, old.values, equal_nan=True)
+    raw = bytearray(old.path.read_bytes())
+    raw[offset + 5] ^= 0x40
+    bad = tmp_path / "flipped.h5"
+    bad.write_bytes(bytes(raw))
+    with pytest.raises(StoreError, match="damaged store: wall_seconds no longer match"):
+        CampaignStore.open(bad)
+    r = subprocess.run([sys.executable, "-m", "pydem", "campaign", "status", str(bad)], capture_output=True, text=True)
+    assert r.returncode != 0 and "Traceback" not in r.stderr and "damaged store: wall_seconds" in r.stderr
