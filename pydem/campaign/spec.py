@@ -86,6 +86,12 @@ class CampaignSpec:
                 self.config({k: v[end] for k, v in self.ranges.items()})
         except ConfigError as exc:
             raise SpecError(str(exc)) from None
+        for k, (lo, hi) in self.ranges.items():  # ... and take the values between them (a whole-number knob cannot)
+            inner = lo + (hi - lo) * 0.4142135623730951
+            try:
+                self.config({k: inner})
+            except ConfigError as exc:
+                raise SpecError(f"ranges.{k}: a design samples values between the ends, and {exc}") from None
 
     @property
     def names(self) -> list[str]:

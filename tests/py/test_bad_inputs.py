@@ -22,6 +22,7 @@ def files(tmp: Path) -> dict:
         "cond.csv": HEADER + "x,ring_shear,mu_ie_ps,0.5,0.01,,sigma=1,calibrate,s\n",
         "seed.toml": 'rig = "aor"\npreset = "tiny"\nseed = 1.5\n[ranges]\nfriction = [0.1, 0.5]\n',
         "bool.toml": "friction = true\n",
+        "int_range.toml": 'rig = "aor"\npreset = "tiny"\n[ranges]\nfriction = [0.1, 0.5]\nparticles = [100, 600]\n',
         "long_field.csv": HEADER + "x,aor,angle_of_repose,30,0.5,deg,,calibrate," + "s" * 200000 + "\n",
         "many_rows.csv": HEADER + "".join(f"x,hopper,mass_flow_rate,0.5,0.01,kg/s,slot_width={0.03 + i * 1e-6:.6f},"
                                           f"calibrate,s\n" for i in range(2001)),
@@ -43,6 +44,8 @@ PROBES = [  # (argv with {file} placeholders, words the message must contain)
     (["rig", "hopper", "--preset", "tiny", "--out", "/nonexistent/dir/r.json"], "cannot write the output"),
     (["campaign", "run", "{seed.toml}", "--store", "{tmp}/s.h5"], "seed: expected an integer in 0..9223372036854775807"),
     (["campaign", "status", "{tmp}/none.h5"], "no such campaign store"),
+    (["campaign", "run", "{int_range.toml}", "--store", "{tmp}/s.h5"], "ranges.particles: a design samples values "
+                                                                       "between the ends, and particles: expected a whole number"),
     (["campaign", "export", "data/campaigns/aor_tiny.h5", "--csv", "/nonexistent/x.csv"], "No such file or directory"),
     (["compare", "{g_cm3.csv}", "--material", "x", "--dem", "r.json"], "is outside the physically possible range"),
     (["compare", "{unknown_test.csv}", "--material", "x", "--dem", "r.json"], "unknown test 'silo'"),
