@@ -57,6 +57,12 @@ def rig_metric(o: Observation) -> str:
     return o.quantity.metric
 
 
+# a Schulze tester's outputs computed from one yield locus (pydem.rigs.yield_locus): accepted in a
+# measurement file, compared by `pydem compare`, left out of a fit with this reason
+LOCUS_OUTPUTS = ("sigma_1", "sigma_c", "ffc", "phi_e", "phi_lin", "phi_sf", "yield_locus_intercept", "tau_shear",
+                 "tau_preshear")
+
+
 class ObservationError(ValueError):
     """A measurement that the surrogates cannot represent (named with its line)."""
 
@@ -67,8 +73,11 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
     rig = m.rig
     if rig not in QUANTITIES or m.quantity not in QUANTITIES[rig]:
         offered = "; ".join(f"{r}: {', '.join(q)}" for r, q in QUANTITIES.items())
-        raise ObservationError(f"line {m.line}: {m.label}: no surrogate quantity for test {m.test!r} quantity "
-                               f"{m.quantity!r} (the diagnosis knows {offered})")
+        why = (f"{m.quantity} is derived from the yield locus's points (Schulze); the diagnosis fits the points "
+               f"themselves — give the row's mu_ie_ps and mu_ie_s at each shear_fraction"
+               if rig == "ring-shear" and m.quantity in LOCUS_OUTPUTS else "no surrogate quantity")
+        raise ObservationError(f"line {m.line}: {m.label}: {why} for test {m.test!r} quantity {m.quantity!r} (the "
+                               f"diagnosis knows {offered})")
     q = Quantity(rig, m.quantity)
     cond, assumed = {}, {}
     for name in q.conditions:

@@ -628,3 +628,15 @@ def test_measurements_past_the_box_are_out_of_reach_not_consistent():
              if o.conditions["condition"] == 0.5]
     d = dg.diagnose("three", three, nets, RANGES, CANDS, say=lambda *a: None, detection_limits=False)
     assert d.verdict == "not_testable" and not d.testable
+
+
+def test_schulze_outputs_are_left_out_with_the_reason(tmp_path):
+    """sigma_1, ffc, phi_e... are accepted in a measurement file (`pydem compare` shows them) but
+    derived from a yield locus's points: the diagnosis says so and names the rows to give."""
+    from pydem.calibration.quantities import ObservationError, observation
+    from pydem.measurements import load
+    f = tmp_path / "m.csv"
+    f.write_text("material,test,quantity,value,uncertainty\nm,ring_shear,ffc,5.2,0.3\nm,ring_shear,sigma_1,4000,50\n")
+    for m in load(f, "m"):
+        with pytest.raises(ObservationError, match=f"{m.quantity} is derived from the yield locus's points.*mu_ie_s"):
+            observation(m, {"preshear_stress": 2000.0})
