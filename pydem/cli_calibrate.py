@@ -56,14 +56,15 @@ def main(args) -> int:
     loaded = load_inputs(args, "calibrate", say)
     if loaded is None:
         return 2
-    setup, obs, skipped = loaded
+    setup, obs, skipped, scaling = loaded
     say(f"calibrating {args.material}: {len(obs)} measurements (stores: libdem {setup.physics})")
     c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
                   args.threads, say)
-    c.notes += [f"left out: {line}" for line in skipped]
+    c.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes()]
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
-               "stores": setup.store_provenance(), "window": args.window, "samples": args.samples}
+               "stores": setup.store_provenance(), "window": args.window, "samples": args.samples,
+               "material": scaling.as_dict()}
     if args.confirm:
         from .calibration.confirm import confirm
         from .progress import RunProgress
@@ -75,7 +76,7 @@ def main(args) -> int:
             files = export_nets(setup.nets, tmp / "nets")
             report.write_calibration(c, tmp, context)
             material_card.write(material_card.card(args.material, setup, c.fit, setup.candidates, c.verdict,
-                                                   report.calibration_line(c)), tmp)
+                                                   report.calibration_line(c), scaling), tmp)
     except OSError as exc:
         print(f"pydem calibrate: cannot write the output ({exc}); an earlier output in {out} is left as it was",
               file=sys.stderr)

@@ -44,7 +44,7 @@ def main(args) -> int:
     loaded = load_inputs(args, "compare", say)
     if loaded is None:
         return 2
-    setup, obs, _ = loaded
+    setup, obs, _, _ = loaded
     try:
         if args.params:
             rows, unmatched = surrogate_rows(obs, setup, _params(args.params)), []

@@ -33,7 +33,7 @@ def main(args) -> int:
     loaded = load_inputs(args, "diagnose", say)
     if loaded is None:
         return 2
-    setup, obs, skipped = loaded
+    setup, obs, skipped, scaling = loaded
     say(f"diagnosing {args.material}: {len(obs)} measurements, candidates "
         f"{', '.join(c.name for c in setup.candidates)} (stores: libdem {setup.physics})")
     try:
@@ -41,10 +41,10 @@ def main(args) -> int:
     except ValueError as exc:
         print(f"pydem diagnose: {exc}", file=sys.stderr)
         return 2
-    d.notes += [f"left out: {line}" for line in skipped]
+    d.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes()]
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
-               "stores": setup.store_provenance(), "libdem_of_stores": setup.physics}
+               "stores": setup.store_provenance(), "libdem_of_stores": setup.physics, "material": scaling.as_dict()}
     if args.confirm:
         from .calibration.confirm import confirm
         from .progress import RunProgress
@@ -55,7 +55,7 @@ def main(args) -> int:
         with output_dir.staged(args.out) as tmp:
             report.write(d, tmp, context)
             material_card.write(material_card.card(args.material, setup, d.after if d.after is not None else d.base,
-                                                   setup.candidates, d.verdict, report.verdict_line(d)), tmp)
+                                                   setup.candidates, d.verdict, report.verdict_line(d), scaling), tmp)
     except OSError as exc:
         print(f"pydem diagnose: cannot write the output ({exc}); an earlier output in {args.out} is left as it was",
               file=sys.stderr)

@@ -34,7 +34,8 @@ def store_paths(args) -> list:
 
 
 def load_inputs(args, command: str, say):
-    """(setup, observations, rows left out), or None after printing why not (exit status 2)."""
+    """(setup, observations, rows left out, the material's Scaling), or None after printing why not
+    (exit status 2)."""
     from .calibration.quantities import ObservationError
     from .calibration.setup import load_setup, observations_of
     from .campaign import StoreError
@@ -49,12 +50,15 @@ def load_inputs(args, command: str, say):
         rows = load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
         setup = load_setup(store_paths(args), say, getattr(args, "retrain", False))
         obs, skipped = observations_of(rows, setup, str(args.measurements), args.material)
+        scaling = setup.scaling(rows)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
         print(f"pydem {command}: {exc}", file=sys.stderr)
         return None
     for line in skipped:
         say(f"  left out: {line}")
-    return setup, obs, skipped
+    for line in scaling.notes():
+        say(f"  material: {line}")
+    return setup, obs, skipped, scaling
 
 
 def seed_value(text: str) -> int:

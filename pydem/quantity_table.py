@@ -41,6 +41,14 @@ _ANGLE = dict(unit="deg", units={"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees"
 _FRICTION = dict(_COEF, noise=("rel", 0.02))
 
 TABLE: dict[str, dict[str, QuantitySpec]] = {
+    # the material itself, said once (calibration/similarity.py): not compared, used to compare
+    "material": {
+        "particle_density": QuantitySpec(unit="kg/m^3", units=_DENSITY["units"], range=(100.0, 2.5e4)),
+        "particle_diameter": QuantitySpec(unit="m", units={"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6},
+                                          range=(1e-7, 1.0)),
+        "youngs_modulus": QuantitySpec(unit="Pa", units={"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "gpa": 1e9}, range=(1e3, 1e13)),
+        "poisson_ratio": QuantitySpec(unit="", units={"": 1.0, "-": 1.0}, range=(0.0, 0.5)),
+    },
     "ring_shear": {
         "mu_ie_ps": QuantitySpec(**_FRICTION, conditions=("preshear_stress",)),
         "mu_ie_s": QuantitySpec(**_FRICTION, conditions=("preshear_stress", "shear_fraction")),

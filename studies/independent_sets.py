@@ -41,6 +41,7 @@ from pydem.calibration.detectability import detectable_effects  # noqa: E402
 from pydem.calibration.diagnose import ALPHA  # noqa: E402
 from pydem.calibration.quantities import Observation  # noqa: E402
 from pydem.calibration.setup import DEFAULT_STORES, load_setup  # noqa: E402
+from pydem.calibration.verdicts import ALARMS  # noqa: E402
 from pydem.quantity_table import TEST_OF_RIG  # noqa: E402
 
 PRESHEAR = (1000.0, 2000.0, 5000.0)
@@ -195,7 +196,7 @@ def summary(args):
         r = json.loads(Path(path).read_text())
         sets = [s for s in r["sets"] if "error" not in s]
         nulls = [s for s in sets if s["kind"] == "null"]
-        fa = sum(bool(s["effects"]) or s["verdict"] != "no_effect_needed" for s in nulls)
+        fa = sum(bool(s["effects"]) or s["verdict"] in ALARMS for s in nulls)
         lo, hi = (stats.beta.ppf(0.025, fa, len(nulls) - fa + 1) if fa else 0.0,
                   stats.beta.ppf(0.975, fa + 1, len(nulls) - fa) if fa < len(nulls) else 1.0)
         single = [s for s in sets if s["kind"] != "null" and "+" not in s["kind"]]

@@ -15,12 +15,15 @@ from ..rigs.result import strict_json
 CLEAN_VERDICTS = ("calibrated", "no_effect_needed", "effect")
 
 
-def card(material: str, setup, fit, candidates, verdict: str, verdict_line: str) -> dict:
+def card(material: str, setup, fit, candidates, verdict: str, verdict_line: str, scaling=None) -> dict:
     """The parameters of a fitted model: the free ones at their estimates (with the posterior's
     95 % interval), the candidates not freed at their neutral values, and the solid and wall
     constants the campaign stores hold fixed; with the report's verdict and the caveats that
     qualify the numbers (a verdict that is not clean, estimates at a range edge, one-sided
-    intervals), which the LIGGGHTS and LAMMPS files repeat as comments above the numbers."""
+    intervals), which the LIGGGHTS and LAMMPS files repeat as comments above the numbers. With a
+    `scaling` (similarity.Scaling: the material's own particle density) the card is in the
+    material's terms: its density, the model's Young's modulus that keeps the stores' stiffness
+    number, and the cohesion energy density scaled back."""
     est = fit.as_dict()
     post = fit.posterior.get("parameters", {})
     values = {c.parameter: c.neutral_value(est) for c in candidates}
@@ -41,6 +44,17 @@ def card(material: str, setup, fit, candidates, verdict: str, verdict_line: str)
                         "calibrated": name in est}
     for name in ("youngs_modulus", "poisson_ratio", "density", "wall_restitution", "wall_rolling_friction"):
         params.setdefault(name, {"value": float(getattr(fixed, name)), "interval_95": None, "calibrated": False})
+    if scaling is not None and scaling.factor != 1.0:
+        params["density"]["value"] = float(scaling.material.particle_density)
+        params["youngs_modulus"]["value"] = float(scaling.model_modulus)
+        coh = params.get("effects.cohesion_sjkr.cohesion_energy_density")
+        if coh is not None:
+            coh["value"] = scaling.cohesion_to_material(coh["value"])
+            if coh["interval_95"] and None not in coh["interval_95"]:
+                coh["interval_95"] = [scaling.cohesion_to_material(x) for x in coh["interval_95"]]
+        caveats.append(f"scaled from the stores' particle density {scaling.store_density:g} kg/m^3 by similarity "
+                       f"(docs/diagnosis.md §1): density, Young's modulus and cohesion energy density in this "
+                       f"material's terms")
     return {"material": material, "verdict": verdict, "caveats": caveats, "models": {"normal": "Hertz", "damping": "restitution-based (seed 000)",
                                              "tangential": "Mindlin history, Coulomb cap", "rolling": fixed.rolling_model,
                                              "effects": sorted({c.name for c in candidates if c.parameter.startswith("effects.")})},

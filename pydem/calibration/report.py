@@ -391,6 +391,12 @@ def provenance_section(context: dict) -> tuple[str, str, str]:
     rows = [[k, str(v)] for k, v in prov.items()]
     if context.get("measurements"):
         rows.append(["measurement file", context["measurements"]])
+    material = context.get("material") or {}
+    given = {k: v for k, v in (material.get("given") or {}).items() if v is not None}
+    rows.append(["the material (its file's `material` rows)", ", ".join(f"{k} {v:.6g}" for k, v in given.items())
+                 + f"; compared with stores at particle density {material.get('store_particle_density', 0):.6g} kg/m^3, "
+                   f"scale {material.get('factor', 1.0):.4g}" if given else "not described: the stores' material "
+                 "(particle density 2500 kg/m^3, E 5 MPa, 3 mm spheres) assumed"])
     for rig, s in (context.get("stores") or {}).items():
         rows.append([f"store ({rig})", f"{s['path']} (made by commit {s.get('commit')}, libdem {s.get('libdem')})"
                      + (f"; pooled: {', '.join(s['pooled'])}" if s.get("pooled") else "")])

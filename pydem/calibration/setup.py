@@ -13,6 +13,7 @@ from ..measurements import load as load_measurements
 from .candidates import BASE_PARAMETERS, Candidate, registry
 from .pooled_runs import check_poolable
 from .quantities import Observation, ObservationError, observation
+from .similarity import MATERIAL_TEST, MaterialProperties, Scaling
 from .store_data import preset_conditions, replicate_stores
 from .surrogates import attach_run_correlations, load_or_train
 
@@ -48,6 +49,12 @@ class Setup:
     physics: str            # libdem major.minor of the runs
     defaults: dict = field(default_factory=dict)  # condition -> preset value (rows that do not give it)
     pooled: dict = field(default_factory=dict)    # rig -> the stores pooled into its surrogates
+
+    def scaling(self, measurements: list) -> Scaling:
+        """How a material's rows are compared with these stores (similarity.py): its particle
+        density against theirs."""
+        params = next(iter(self.stores.values())).spec.config({}).params
+        return Scaling(MaterialProperties.from_rows(measurements), float(params.density), float(params.youngs_modulus))
 
     def store_provenance(self) -> dict:
         """{rig: path, commit and libdem of its store, and the paths of the stores pooled in}, for reports."""
@@ -121,11 +128,13 @@ def observations_from_file(path: str | Path, material: str, setup: Setup) -> tup
 def observations_of(measurements: list, setup: Setup, source: str, material: str) -> tuple[list[Observation], list[str]]:
     """(usable observations, one line per row left out and why) of a material's measurement rows
     (measurements.load), read from `source`."""
-    rows = [m for m in measurements if m.use == "calibrate"]
+    rows = [m for m in measurements if m.use == "calibrate" and m.test != MATERIAL_TEST]
+    scaling = setup.scaling(measurements)
+    scaled = " (scaled to the stores' particle density)" if scaling.factor != 1.0 else ""
     out, skipped = [], []
     for m in rows:
         try:
-            o = observation(m, setup.defaults)
+            o = scaling.observation(observation(m, setup.defaults))
         except ObservationError as exc:
             skipped.append(str(exc))
             continue
@@ -138,7 +147,7 @@ def observations_of(measurements: list, setup: Setup, source: str, material: str
                    for k, v in o.conditions.items() if k in net.input_names
                    and not net.lo[net.input_names.index(k)] <= v <= net.hi[net.input_names.index(k)]]
         if outside:
-            skipped.append(f"line {m.line}: {m.label}: condition {', '.join(outside)} (the campaign's range)")
+            skipped.append(f"line {m.line}: {m.label}: condition {', '.join(outside)} (the campaign's range){scaled}")
             continue
         # a condition the store does not vary: its runs all have one value, and the row must have it too
         other = [f"{k}={v:g} but the campaign ran at {setup.defaults[k]:g} only" for k, v in o.conditions.items()
