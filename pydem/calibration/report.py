@@ -395,8 +395,8 @@ def provenance_section(context: dict) -> tuple[str, str, str]:
     given = {k: v for k, v in (material.get("given") or {}).items() if v is not None}
     rows.append(["the material (its file's `material` rows)", ", ".join(f"{k} {v:.6g}" for k, v in given.items())
                  + f"; compared with stores at particle density {material.get('store_particle_density', 0):.6g} kg/m^3, "
-                   f"scale {material.get('factor', 1.0):.4g}" if given else "not described: the stores' material "
-                 "(particle density 2500 kg/m^3, E 5 MPa, 3 mm spheres) assumed"])
+                   f"scale {material.get('factor', 1.0):.4g}" if given else f"not described: the stores' material "
+                 f"assumed (particle density {material.get('store_particle_density', float('nan')):.6g} kg/m^3)"])
     for rig, s in (context.get("stores") or {}).items():
         rows.append([f"store ({rig})", f"{s['path']} (made by commit {s.get('commit')}, libdem {s.get('libdem')})"
                      + (f"; pooled: {', '.join(s['pooled'])}" if s.get("pooled") else "")])
