@@ -82,7 +82,7 @@ $(BUILD)/tests/%: tests/c/%.c $(wildcard tests/c/*.h) $(BUILD)/libdem.a
 # each stage timed; the total goes into the CHANGELOG at each release
 test: setup
 	@t0=$$(date +%s); for stage in test-c test-sanitize test-minimal test-py; do \
-	  s=$$(date +%s); $(MAKE) --no-print-directory $$stage || exit 1; \
+	  s=$$(date +%s); $(MAKE) -j$(shell nproc) --no-print-directory $$stage || exit 1; \
 	  echo "== $$stage: $$(( $$(date +%s) - s )) s"; done; \
 	echo "== make test passed in $$(( $$(date +%s) - t0 )) s"
 
@@ -106,7 +106,9 @@ SAN_OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sani
 test-sanitize:
 	@echo "== C tests under ASan + UBSan"
 	@mkdir -p $(BUILD)
-	@$(MAKE) --no-print-directory -s BUILD=$(BUILD)/sanitize OPT="$(SAN_OPT)" test-c > $(BUILD)/sanitize.log 2>&1 \
+	@$(MAKE) --no-print-directory -s -j$(shell nproc) BUILD=$(BUILD)/sanitize OPT="$(SAN_OPT)" lib $(TEST_BIN:$(BUILD)/%=$(BUILD)/sanitize/%) > $(BUILD)/sanitize.log 2>&1 \
+	  || (cat $(BUILD)/sanitize.log; echo "sanitizer build FAILED (log: $(BUILD)/sanitize.log)"; exit 1)
+	@$(MAKE) --no-print-directory -s BUILD=$(BUILD)/sanitize OPT="$(SAN_OPT)" test-c >> $(BUILD)/sanitize.log 2>&1 \
 	  || (cat $(BUILD)/sanitize.log; echo "sanitizer run FAILED (log: $(BUILD)/sanitize.log)"; exit 1)
 	@grep -cE "^\[  PASSED  \]" $(BUILD)/sanitize.log | xargs printf "   %s test programs passed (log: $(BUILD)/sanitize.log)\n"
 
@@ -127,10 +129,12 @@ $(PYDEM_STAMP): $(BUILD)/libdem.a $(wildcard include/dem/*.h) pydem/_build_ffi.p
 	@rm -f pydem/_libdem.abi3.so  # the source-built copy of `pip install -e .`: one binding, make's
 	@touch $@
 
-# the 15 slowest tests are listed after every run, so a test that grows is seen
+# the 15 slowest tests are listed after every run, so a test that grows is seen; one worker per
+# core (pytest-xdist), the tests of one file in one worker (they share its fixtures)
 PYTEST_ARGS ?=
+PYTEST_WORKERS ?= $(shell nproc)
 test-py: pydem
-	$(PYTHON) -m pytest -q --durations=15 $(PYTEST_ARGS) tests/py
+	$(PYTHON) -m pytest -q --durations=15 -n $(PYTEST_WORKERS) --dist loadfile $(PYTEST_ARGS) tests/py
 
 $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)
