@@ -270,3 +270,23 @@ def test_calibrate_screens_on_the_threads_omp_num_threads_gives():
         os.environ.pop("OMP_NUM_THREADS") if old is None else os.environ.__setitem__("OMP_NUM_THREADS", old)
     args = ap.parse_args(["x.csv", "--material", "m", "--threads", "0"])
     assert load_inputs(args, "calibrate", lambda *a: None) is None
+
+
+def test_a_condition_a_little_past_the_runs_is_used_and_said(tiny, tmp_path):
+    """A design's extreme points stop short of its spec's ends (seed 000 pre-shears at 10.07 kPa, the
+    default store's runs end at 9.997 kPa): up to 5 % of the range past the runs a row is compared,
+    with a note that the surrogate extrapolates; further out it is left out, saying the limit."""
+    from pydem.calibration.calibrate import row_notes
+    from pydem.calibration.setup import EXTRAPOLATE, observations_of
+    from pydem.measurements import load
+    q = next(q for q in tiny.nets if q.rig == "ring-shear" and q.metric == "mu_ie_ps")
+    net = tiny.nets[q]
+    lo, hi = (x[net.input_names.index("preshear_stress")] for x in (net.lo, net.hi))
+    f = tmp_path / "m.csv"
+    f.write_text("material,test,quantity,value,uncertainty,unit,conditions\n"
+                 f"m,ring_shear,mu_ie_ps,0.55,0.01,,preshear_stress={hi + 0.02 * (hi - lo):.6g}\n"
+                 f"m,ring_shear,mu_ie_ps,0.55,0.01,,preshear_stress={hi + 2 * EXTRAPOLATE * (hi - lo):.6g}\n")
+    obs, skipped = observations_of(load(f, "m"), tiny, "m.csv", "m")
+    assert len(obs) == 1 and "2.0 % of the range past the runs" in obs[0].extrapolated["preshear_stress"]
+    assert any("the surrogate extrapolates" in n for n in row_notes(obs))
+    assert len(skipped) == 1 and "5 % past it allowed" in skipped[0]
