@@ -130,11 +130,11 @@ $(PYDEM_STAMP): $(BUILD)/libdem.a $(wildcard include/dem/*.h) pydem/_build_ffi.p
 	@touch $@
 
 # the 15 slowest tests are listed after every run, so a test that grows is seen; one worker per
-# core (pytest-xdist), the tests of one file in one worker (they share its fixtures)
+# core (pytest-xdist), each test where a worker is free (a module fixture is made once per worker)
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= $(shell nproc)
 test-py: pydem
-	$(PYTHON) -m pytest -q --durations=15 -n $(PYTEST_WORKERS) --dist loadfile $(PYTEST_ARGS) tests/py
+	$(PYTHON) -m pytest -q --durations=15 -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS) tests/py
 
 $(BUILD)/bench/%: bench/%.c bench/lattice.h $(BUILD)/libdem.a
 	@mkdir -p $(dir $@)

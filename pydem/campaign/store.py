@@ -266,7 +266,7 @@ class CampaignStore:
                     raise StoreError(f"{path}: not a pydem campaign store (format attribute {f.attrs.get('format')!r})")
                 if int(f.attrs["format_version"]) > FORMAT_VERSION:
                     raise StoreError(f"{path}: store format {f.attrs['format_version']} is newer than this pydem reads")
-                if "checksums" in f.attrs:  # stores saved before format 3 have none
+                if "checksums" in f.attrs and int(f.attrs["format_version"]) >= 3:  # none before format 3
                     stored, now = json.loads(f.attrs["checksums"]), _checksums(f)
                     bad = [k for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
                     if bad:

@@ -57,8 +57,8 @@ def test_stores_whose_runs_are_not_points_of_the_box_are_refused(change, words):
 
 def test_a_store_varying_more_than_the_main_one_is_refused():
     main = store("three.h5", THREE, [[0.3, 0.1, 0.4]], [[30.0, 1490.0]])
-    wide = store("other.h5", {**THREE, "particles": (500, 700)}, [[0.3, 0.1, 0.4, 600]], [[30.0, 1490.0]])
-    with pytest.raises(PoolError, match="varies particles"):
+    wide = store("other.h5", {**THREE, "wall_restitution": (0.3, 0.7)}, [[0.3, 0.1, 0.4, 0.5]], [[30.0, 1490.0]])
+    with pytest.raises(PoolError, match="varies wall_restitution"):
         check_poolable(main, wide)
 
 

@@ -69,3 +69,7 @@ def test_report_renders_with_its_images(command, tmp_path):
     # the verdict opens both reports, before any plot
     page = (out / "report.html").read_text()
     assert page.index("class='verdict'") < page.index("<img")
+    # every statistic explained in plain words, and what made the report
+    for heading in ("What the numbers mean", "Provenance"):
+        assert f"<h2>{heading}</h2>" in page
+    assert ("LR (likelihood ratio)" in page) == (command == "diagnose") and "git_commit" in page
