@@ -291,6 +291,8 @@ def detectable_section(detectable: dict, units: dict) -> tuple[str, str, str]:
     def side(v, info, key):
         if key not in info:
             return "(one-sided)"
+        if v is None and key not in info["signal_at_edge"]:  # the neutral value sits on that edge
+            return "none: the neutral value is the range's edge"
         return _g(v) if v is not None else f"not within the range (signal at its edge {info['signal_at_edge'][key]:.1f})"
     def next_test(info):
         n = info.get("measure_next")

@@ -640,3 +640,13 @@ def test_schulze_outputs_are_left_out_with_the_reason(tmp_path):
     for m in load(f, "m"):
         with pytest.raises(ObservationError, match=f"{m.quantity} is derived from the yield locus's points.*mu_ie_s"):
             observation(m, {"preshear_stress": 2000.0})
+
+
+def test_a_neutral_value_on_the_range_edge_renders():
+    """Wall friction's neutral value follows the particle friction; fitted at the box's edge it
+    leaves no room on that side: the detection-limit table says so (it raised a KeyError)."""
+    from pydem.calibration.report import detectable_section
+    info = {"neutral": 1.0, "range": [0.0, 1.0], "power": 0.9, "alpha": 0.01, "signal_needed": 13.0,
+            "signal_at_edge": {"below": 40.0}, "below": 0.7, "above": None}
+    _, md, _ = detectable_section({"wall_friction": info}, {})
+    assert "none: the neutral value is the range's edge" in md and "0.7" in md
