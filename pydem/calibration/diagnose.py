@@ -112,6 +112,7 @@ class Diagnosis:
     detectable: dict = field(default_factory=dict)  # per candidate: the smallest effect these rows would show
     added: list[CandidateResult] = field(default_factory=list)  # effects forward selection added after the first
     reach: list[dict] = field(default_factory=list)  # the final fit's parameters held back by the box (reach.py)
+    hidden: dict = field(default_factory=dict)  # candidate -> the band its intervals were marginalised over
 
     @property
     def effects(self) -> list[str]:
@@ -138,6 +139,7 @@ class Diagnosis:
                             "interval": p.get("interval")}
         return {"material": self.material, "verdict": self.verdict, "effect": self.effect, "effects": self.effects,
                 "added": [a.as_dict() for a in self.added], "testable": self.testable, "reach": self.reach,
+                "intervals_over_hidden_effects": self.hidden,
                 "candidates": [c.as_dict() for c in self.candidates], "not_covered": self.not_covered,
                 "before": self.summary_of(self.base, self.base_model),
                 "after": self.summary_of(self.after, self.after_model),
@@ -304,6 +306,45 @@ def outlier_screen(d: Diagnosis, nets: dict, ranges: dict) -> tuple[int, dict] |
                "chi2_per_dof_without": f.chi2_per_dof, "model_tested": free.name if free is not None else "base"}
 
 
+def marginalise_hidden(observations, nets, ranges, covered, final_model: Model, final_fit: Fit,
+                       detectable: dict) -> dict:
+    """The final model's intervals over the effects these measurements cannot rule out: every
+    covered candidate the final model leaves at its neutral value is freed within its detection
+    limits (uniform between them: an effect past a limit would have been found with 90 %
+    probability), and the posterior of that larger model gives the intervals of the final model's
+    parameters, widened to hold their most probable values. Why: a base parameter absorbs an effect
+    too small to name — a null material's wall friction 0.036 off its particle friction moved the
+    particle friction's estimate past its 95 % interval (docs/diagnosis.md §7). Returns
+    {candidate: [lo, hi]} of the bands used (empty: nothing hidden), the final fit's posterior
+    intervals replaced in place."""
+    theta = final_fit.as_dict()
+    freed = [c for c in covered if c.parameter in final_model.free]
+    bands, hidden = {}, []
+    for c in covered:
+        info = detectable.get(c.name)
+        if c in freed or info is None:
+            continue
+        lo_r, hi_r = ranges[c.parameter]
+        lo = info["neutral"] if "below" not in info else (info["below"] if info["below"] is not None else lo_r)
+        hi = info["above"] if info.get("above") is not None else (hi_r if "above" in info["signal_at_edge"] else info["neutral"])
+        lo, hi = max(min(lo, hi), lo_r), min(max(lo, hi), hi_r)
+        if hi - lo > 1e-12 * max(1.0, abs(hi)):
+            bands[c.name] = [float(lo), float(hi)]
+            hidden.append(c)
+    if not hidden:
+        return {}
+    box = dict(ranges) | {c.parameter: tuple(bands[c.name]) for c in hidden}
+    at = np.append(final_fit.best, [np.clip(c.neutral_value(theta), *box[c.parameter]) for c in hidden])
+    model = Model(observations, nets, box, covered, freed + hidden, at=at)
+    wide = minimise(model, starts=256, keep=2, start=at)
+    post = posterior(model, wide)
+    for name, p in final_fit.posterior["parameters"].items():
+        q = post["parameters"][name]
+        p["lo"], p["hi"] = min(q["lo"], p["estimate"]), max(q["hi"], p["estimate"])
+        p["interval"] = "over the effects not ruled out"
+    return bands
+
+
 def _test_on_top(observations, nets, ranges, covered, free: list[Candidate], fitted: Fit, c: Candidate) -> CandidateResult:
     """Candidate c tested on top of the null model with the `free` candidates freed (fitted: its fit
     with the noise model at its own optimum): c's parameter freed too, started from that fit with
@@ -435,8 +476,15 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
     elif reach and verdict == "unexplained" and final_fit.dof > 0 and stats.chi2.sf(
             max(final_fit.chi2 - max(r["gain"] for r in reach), 0.0), final_fit.dof) >= ACCEPT:
         verdict = "out_of_reach"  # the misfit is what the edge holds back: past it the fit would pass
+    hidden = {}
+    if detectable and verdict in ("no_effect_needed", "effect", "out_of_reach"):
+        hidden = marginalise_hidden(observations, nets, ranges, covered, final_model, final_fit, detectable)
+        for r in ([chosen] + added) if chosen is not None else []:
+            p = final_fit.posterior["parameters"][r.parameter]
+            r.estimate_lo, r.estimate_hi = p["lo"], p["hi"]
     window = window_screen(final_model, 0.05, 2 ** 16, threads=1, keep_points=False)
     return Diagnosis(material, observations, base, base_model, results, not_covered, verdict,
                      chosen.effect if chosen is not None and verdict in ("effect", "indistinguishable") else None,
                      after, after_model, similarity, separating, groups, loco, notes, testable, window,
-                     detectable=detectable, added=added if verdict == "effect" else [], reach=reach)
+                     detectable=detectable, added=added if verdict == "effect" else [], reach=reach,
+                     hidden=hidden)

@@ -321,7 +321,9 @@ def parameter_section(params: dict, window: dict | None, title: str) -> tuple[st
                               "at range edge"])
     line = ("The most probable value is the best fit (the posterior's mode for a uniform prior on the campaign box); "
             "the interval holds 95 % of the posterior, central, or from the range's edge when the posterior piles "
-            "against it and the most probable value lies outside the central one.")
+            "against it and the most probable value lies outside the central one. In a diagnosis the posterior is "
+            "taken with every candidate effect not named free within its detection limits (the effects these "
+            "measurements cannot rule out), so the intervals also hold what such an effect would move.")
     md += "\n\n" + line
     h += f"<p>{html.escape(line)}</p>"
     if window:

@@ -650,3 +650,20 @@ def test_a_neutral_value_on_the_range_edge_renders():
             "signal_at_edge": {"below": 40.0}, "below": 0.7, "above": None}
     _, md, _ = detectable_section({"wall_friction": info}, {})
     assert "none: the neutral value is the range's edge" in md and "0.7" in md
+
+
+def test_intervals_are_taken_over_the_effects_not_ruled_out():
+    """A clean verdict's intervals are marginalised over every candidate freed within its detection
+    limits (the bands reported are those limits: cohesion-like a from 0, b on both sides), and
+    are at least as wide as the base model's own."""
+    nets, obs = world()
+    d = dg.diagnose("null", generate(nets, obs, (0.4, 0.5, 0.5), {}, np.random.default_rng(0)), nets, RANGES, CANDS,
+                    say=lambda *a: None)
+    assert d.verdict == "no_effect_needed"
+    lim = d.detectable
+    assert d.hidden == {"a": [0.0, pytest.approx(lim["a"]["above"])],
+                        "b": [pytest.approx(lim["b"]["below"]), pytest.approx(lim["b"]["above"])]}
+    own = posterior(d.base_model, d.base)["parameters"]
+    for name, p in d.as_dict()["parameters"].items():
+        assert p["interval"] == "over the effects not ruled out" and p["lo"] <= p["estimate"] <= p["hi"]
+        assert p["hi"] - p["lo"] >= 0.999 * (own[name]["hi"] - own[name]["lo"])
