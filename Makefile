@@ -112,8 +112,13 @@ test-sanitize:
 	  || (cat $(BUILD)/sanitize.log; echo "sanitizer run FAILED (log: $(BUILD)/sanitize.log)"; exit 1)
 	@grep -cE "^\[  PASSED  \]" $(BUILD)/sanitize.log | xargs printf "   %s test programs passed (log: $(BUILD)/sanitize.log)\n"
 
+# the test programs one per core at a time, the longest first (most are single-threaded at their
+# sizes; under the sanitizers test_stress alone runs ~80 s), each one's output printed whole, in order
+LONG_TESTS := $(filter %/test_stress %/test_determinism,$(TEST_BIN))
 test-c: lib $(TEST_BIN) $(BUILD)/libdem_example
-	@set -e; for t in $(TEST_BIN); do echo "== $$t"; OMP_NUM_THREADS=2 $$t; done
+	@printf '%s\n' $(LONG_TESTS) $(filter-out $(LONG_TESTS),$(TEST_BIN)) | xargs -P $(shell nproc) -I{} sh -c 'OMP_NUM_THREADS=2 {} > {}.log 2>&1; echo $$? > {}.rc'
+	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; cat $$t.log; [ "$$(cat $$t.rc)" = 0 ] || { echo "FAILED: $$t"; fail=1; }; \
+	  done; exit $$fail
 	@echo "== docs/libdem.md example"; $(BUILD)/libdem_example
 
 $(BUILD)/libdem_example: docs/libdem.md $(BUILD)/libdem.a
