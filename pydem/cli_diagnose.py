@@ -61,5 +61,7 @@ def main(args) -> int:
               file=sys.stderr)
         return 1
     say(f"verdict: {d.verdict}" + (f" ({' + '.join(d.effects)})" if d.effect else "") + f" — {report.verdict_line(d)}")
+    for r in [c for c in d.candidates if c.effect == d.effect] + d.added if d.effect else []:
+        say(f"  {r.effect}: {r.estimate:.4g} {r.unit} (95 % {r.estimate_lo:.4g}-{r.estimate_hi:.4g}), the final model's")
     say(f"report: {Path(args.out) / 'report.html'} ({time.perf_counter() - t0:.0f} s)")
     return 0

@@ -391,7 +391,7 @@ def _diagnose_rows(material: str, observations: list[Observation], nets: dict, r
         res.score, res.score_step = float(s), float(step)
         results.append(res)
         say(f"  {c.name:16s} LR {res.statistic:8.2f}  p {res.p_value:9.2g}  dBIC {res.delta_bic:8.2f}  score {s:8.2f}  "
-            f"estimate {res.estimate:.4g} {c.unit}")
+            f"(its refit: {res.estimate:.4g} {c.unit})")
     results.sort(key=lambda r: (-r.statistic, r.effect))
     detectable = {}
     if covered_for_tests and detection_limits:
