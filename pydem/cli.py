@@ -9,7 +9,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .cli_inputs import check_writable, seed_value
+from .cli_inputs import seed_value
+from .output_dir import check_writable
 from .errors import DemError
 from .progress import RunProgress
 from .rigs import RIGS, ConfigError, load

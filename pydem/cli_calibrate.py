@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from . import output_dir
-from .cli_inputs import add_common, load_inputs
+from .cli_inputs import add_common, load_inputs, output_checked
 
 # combinations screened at most: the screening holds a float64 per combination and row (2^22 x 30
 # rows: 1 GiB), and seed 000 screened 10^6
@@ -48,10 +48,7 @@ def main(args) -> int:
         print(f"pydem calibrate: --samples must lie in 1..{MAX_SAMPLES} (2^22) and --window in (0, 1) (got "
               f"{args.samples}, {args.window})", file=sys.stderr)
         return 2
-    try:
-        output_dir.check(args.out)  # before any work
-    except output_dir.OutputError as exc:
-        print(f"pydem calibrate: {exc}", file=sys.stderr)
+    if not output_checked(args.out, "calibrate"):
         return 2
     loaded = load_inputs(args, "calibrate", say)
     if loaded is None:

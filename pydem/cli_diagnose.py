@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import sys
 import time
-
 from pathlib import Path
 
 from . import output_dir
-from .cli_inputs import add_common, load_inputs
+from .cli_inputs import add_common, load_inputs, output_checked
 
 
 def add_parser(sub):
@@ -25,10 +24,7 @@ def main(args) -> int:
     from .calibration.diagnose import diagnose
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
-    try:
-        output_dir.check(args.out)  # before any work
-    except output_dir.OutputError as exc:
-        print(f"pydem diagnose: {exc}", file=sys.stderr)
+    if not output_checked(args.out, "diagnose"):
         return 2
     loaded = load_inputs(args, "diagnose", say)
     if loaded is None:

@@ -1,11 +1,11 @@
 """What the commands share of their inputs: the measurement file, the material and the campaign
-stores (`pydem diagnose`, `calibrate`, `compare`), and the check that an output can be written
-before any work is done."""
+stores (`pydem diagnose`, `calibrate`, `compare`), the seeds, and the output checked before any
+work is done (pydem.output_dir)."""
 from __future__ import annotations
 
-import os
 import sys
-from pathlib import Path
+
+from . import output_dir
 
 
 def add_common(p, out: str):
@@ -49,8 +49,8 @@ def load_inputs(args, command: str, say):
     try:
         rows = load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
         setup = load_setup(store_paths(args), say, getattr(args, "retrain", False))
-        obs, skipped = observations_of(rows, setup, str(args.measurements), args.material)
         scaling = setup.scaling(rows)
+        obs, skipped = observations_of(rows, setup, str(args.measurements), args.material, scaling)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
         print(f"pydem {command}: {exc}", file=sys.stderr)
         return None
@@ -74,13 +74,12 @@ def seed_value(text: str) -> int:
     return v
 
 
-def check_writable(path: str, directory: bool):
-    """Raises OSError naming the path when it cannot be written (a directory is created)."""
-    p = Path(path)
-    d = p if directory else (p.parent if str(p.parent) else Path("."))
-    if directory:
-        p.mkdir(parents=True, exist_ok=True)
-    if not d.is_dir():
-        raise OSError(f"{d}: no such directory")
-    if not os.access(d, os.W_OK) or (p.exists() and not directory and not os.access(p, os.W_OK)):
-        raise OSError(f"{path}: permission denied")
+def output_checked(out: str, command: str) -> bool:
+    """`--out` of diagnose and calibrate checked before any work (output_dir.check); False after
+    printing why not (exit status 2)."""
+    try:
+        output_dir.check(out)
+    except output_dir.OutputError as exc:
+        print(f"pydem {command}: {exc}", file=sys.stderr)
+        return False
+    return True

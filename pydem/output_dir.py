@@ -1,4 +1,6 @@
-"""A command's output directory, written whole or not at all (`pydem diagnose`, `calibrate`).
+"""Where a command's output goes, checked before any work: a rig's result file and frame folders
+(check_writable), and the output directory of `pydem diagnose` and `calibrate`, written whole or
+not at all.
 
 check() runs before any work: the directory must be new, empty, or an earlier output of pydem (it
 holds one of MARKERS), and its parent writable — a mistyped --out is found in a second, not after
@@ -64,3 +66,15 @@ def staged(out: str | Path) -> Iterator[Path]:
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+def check_writable(path: str, directory: bool):
+    """Raises OSError naming the path when it cannot be written (a directory is created)."""
+    p = Path(path)
+    d = p if directory else (p.parent if str(p.parent) else Path("."))
+    if directory:
+        p.mkdir(parents=True, exist_ok=True)
+    if not d.is_dir():
+        raise OSError(f"{d}: no such directory")
+    if not os.access(d, os.W_OK) or (p.exists() and not directory and not os.access(p, os.W_OK)):
+        raise OSError(f"{path}: permission denied")

@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..measurements import Measurement
-from ..quantity_table import CONDITION_UNITS, SURROGATE_CONDITIONS, per_fraction_metric, rig_quantities
+from ..quantity_table import CONDITION_UNITS, SURROGATE_CONDITIONS, TABLE, per_fraction_metric, rig_quantities
 
 # the conditions each rig's surrogates take and the quantities they model (pydem.quantity_table)
 CONDITIONS = SURROGATE_CONDITIONS
@@ -58,12 +58,6 @@ def rig_metric(o: Observation) -> str:
     return o.quantity.metric
 
 
-# a Schulze tester's outputs computed from one yield locus (pydem.rigs.yield_locus): accepted in a
-# measurement file, compared by `pydem compare`, left out of a fit with this reason
-LOCUS_OUTPUTS = ("sigma_1", "sigma_c", "ffc", "phi_e", "phi_lin", "phi_sf", "yield_locus_intercept", "tau_shear",
-                 "tau_preshear")
-
-
 class ObservationError(ValueError):
     """A measurement that the surrogates cannot represent (named with its line)."""
 
@@ -74,9 +68,11 @@ def observation(m: Measurement, defaults: dict[str, float]) -> Observation:
     rig = m.rig
     if rig not in QUANTITIES or m.quantity not in QUANTITIES[rig]:
         offered = "; ".join(f"{r}: {', '.join(q)}" for r, q in QUANTITIES.items())
+        # the ring-shear quantities a file may carry but no surrogate models: a Schulze tester's
+        # outputs of one yield locus (pydem.rigs.yield_locus) and its raw stresses
         why = (f"{m.quantity} is derived from the yield locus's points (Schulze); the diagnosis fits the points "
                f"themselves — give the row's mu_ie_ps and mu_ie_s at each shear_fraction"
-               if rig == "ring-shear" and m.quantity in LOCUS_OUTPUTS else "no surrogate quantity")
+               if rig == "ring-shear" and m.quantity in TABLE[m.test] else "no surrogate quantity")
         raise ObservationError(f"line {m.line}: {m.label}: {why} for test {m.test!r} quantity {m.quantity!r} (the "
                                f"diagnosis knows {offered})")
     q = Quantity(rig, m.quantity)

@@ -17,6 +17,7 @@ from .diagnose import ALPHA, Diagnosis
 from .reach import sentence as reach_sentence
 from .verdicts import ACCEPT, TEXT
 
+
 def verdict_line(d: Diagnosis) -> str:
     sig = [c.effect for c in d.candidates if c.p_value < ALPHA and c.effect != d.effect]
     text = TEXT["effects" if d.verdict == "effect" and d.added else d.verdict]

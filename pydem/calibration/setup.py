@@ -132,11 +132,13 @@ def observations_from_file(path: str | Path, material: str, setup: Setup) -> tup
 EXTRAPOLATE = 0.05
 
 
-def observations_of(measurements: list, setup: Setup, source: str, material: str) -> tuple[list[Observation], list[str]]:
+def observations_of(measurements: list, setup: Setup, source: str, material: str,
+                    scaling: Scaling | None = None) -> tuple[list[Observation], list[str]]:
     """(usable observations, one line per row left out and why) of a material's measurement rows
-    (measurements.load), read from `source`."""
+    (measurements.load), read from `source`, compared with the stores through `scaling` (default:
+    setup.scaling of these rows)."""
     rows = [m for m in measurements if m.use == "calibrate" and m.test != MATERIAL_TEST]
-    scaling = setup.scaling(measurements)
+    scaling = scaling if scaling is not None else setup.scaling(measurements)
     scaled = " (scaled to the stores' particle density)" if scaling.factor != 1.0 else ""
     out, skipped = [], []
     for m in rows:
