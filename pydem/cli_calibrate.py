@@ -57,7 +57,7 @@ def main(args) -> int:
     say(f"calibrating {args.material}: {len(obs)} measurements (stores: libdem {setup.physics})")
     c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
                   args.threads, say)
-    c.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes()]
+    c.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes(setup.ranges)]
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
                "stores": setup.store_provenance(), "window": args.window, "samples": args.samples,

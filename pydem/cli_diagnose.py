@@ -37,7 +37,7 @@ def main(args) -> int:
     except ValueError as exc:
         print(f"pydem diagnose: {exc}", file=sys.stderr)
         return 2
-    d.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes()]
+    d.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes(setup.ranges)]
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
                "stores": setup.store_provenance(), "libdem_of_stores": setup.physics, "material": scaling.as_dict()}

@@ -38,6 +38,7 @@ def load_inputs(args, command: str, say):
     (exit status 2)."""
     from .calibration.quantities import ObservationError
     from .calibration.setup import load_setup, observations_of
+    from .calibration.similarity import MaterialProperties
     from .campaign import StoreError
     from .measurements import MeasurementError, load as load_measurements
     from .rigs.config import default_threads
@@ -48,15 +49,17 @@ def load_inputs(args, command: str, say):
             return None
     try:
         rows = load_measurements(args.measurements, args.material)  # the file's own errors first: cheap, and the user's
+        material = MaterialProperties.from_rows(rows)
         setup = load_setup(store_paths(args), say, getattr(args, "retrain", False))
-        scaling = setup.scaling(rows)
+        scaling = setup.scaling(material)
+        setup = setup.for_material(scaling)
         obs, skipped = observations_of(rows, setup, str(args.measurements), args.material, scaling)
     except (MeasurementError, ObservationError, StoreError, ValueError, OSError) as exc:
         print(f"pydem {command}: {exc}", file=sys.stderr)
         return None
     for line in skipped:
         say(f"  left out: {line}")
-    for line in scaling.notes():
+    for line in scaling.notes(setup.ranges):
         say(f"  material: {line}")
     return setup, obs, skipped, scaling
 

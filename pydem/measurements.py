@@ -141,7 +141,7 @@ def load(path: str | Path, material: str | None = None) -> list[Measurement]:
         unc = _number(rec["uncertainty"], where("uncertainty"), True) * factor
         if unc == unc and unc <= 0:
             raise MeasurementError(f"{where('uncertainty')}: must be positive (or empty when unknown), got {unc:g}")
-        if not vmin <= value <= vmax or (vmin == 0.0 and value == 0.0 and quantity != "angle_of_repose"):
+        if not vmin <= value <= vmax or (vmin == 0.0 and value == 0.0 and not spec.zero_ok):
             u_txt = f" {si_unit}" if si_unit else ""
             raise MeasurementError(f"{where('value')}: {quantity} = {value:g}{u_txt} is outside the physically "
                                    f"possible range ({vmin:g}, {vmax:g}]{u_txt}")

@@ -19,6 +19,7 @@ class QuantitySpec:
     conditions: tuple[str, ...] | None = None  # the surrogates' condition inputs; None: not modelled
     noise: tuple[str, float] | None = None     # synthetic sets' lab noise: ('rel', fraction) or ('abs', SI)
     scales_with_density: bool = False          # proportional to the solid density (bulk density, mass flow)
+    zero_ok: bool = False                      # 0 is a possible value (else a range starting at 0 is open there)
 
 
 # the rig that models each test ("poured": the bulk density of the angle-of-repose rig's filled cylinder)
@@ -27,7 +28,7 @@ RIG_OF_TEST = {"ring_shear": "ring-shear", "aor": "aor", "hopper": "hopper", "po
 TEST_OF_RIG = {"ring-shear": "ring_shear", "aor": "aor", "hopper": "hopper"}
 # every condition a measurement row may give, with its unit
 CONDITION_UNITS = {"preshear_stress": "Pa", "shear_fraction": "", "slot_width": "m", "size_cut_mm": "mm",
-                   "mean_diameter_mm": "mm"}
+                   "mean_diameter_mm": "mm", "sieve_mm": "mm"}
 # the conditions each rig's surrogates take as inputs (SI)
 SURROGATE_CONDITIONS = {"ring-shear": ("preshear_stress", "shear_fraction"), "aor": (), "hopper": ("slot_width",)}
 
@@ -38,6 +39,7 @@ _DENSITY = dict(unit="kg/m^3", units={"kg/m^3": 1.0, "kg/m3": 1.0, "kg m-3": 1.0
 _STRESS = dict(unit="Pa", units={"pa": 1.0, "kpa": 1000.0}, range=(0.0, 1e8))
 _ANGLE = dict(unit="deg", units={"deg": 1.0, "°": 1.0, "degree": 1.0, "degrees": 1.0, "rad": 57.29577951308232},
               range=(0.0, 90.0))
+_FRACTION = dict(unit="", units={"": 1.0, "-": 1.0, "%": 0.01}, range=(0.0, 1.0), zero_ok=True)
 _FRICTION = dict(_COEF, noise=("rel", 0.02))
 
 TABLE: dict[str, dict[str, QuantitySpec]] = {
@@ -48,6 +50,11 @@ TABLE: dict[str, dict[str, QuantitySpec]] = {
                                           range=(1e-7, 1.0)),
         "youngs_modulus": QuantitySpec(unit="Pa", units={"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "gpa": 1e9}, range=(1e3, 1e13)),
         "poisson_ratio": QuantitySpec(unit="", units={"": 1.0, "-": 1.0}, range=(0.0, 0.5)),
+        # diameters uniform in d (1 +- spread), the rigs' own description of a size distribution
+        "size_spread": QuantitySpec(**dict(_FRACTION, units={"": 1.0, "-": 1.0})),
+        # a sieve table: the mass fraction retained on each class, named by its lower sieve size
+        # (condition sieve_mm=<mm>, or sieve_mm=pan), as ../shared/data/jku_psd.csv gives them
+        "sieve_retained": QuantitySpec(**_FRACTION),
     },
     "ring_shear": {
         "mu_ie_ps": QuantitySpec(**_FRICTION, conditions=("preshear_stress",)),
@@ -60,7 +67,7 @@ TABLE: dict[str, dict[str, QuantitySpec]] = {
         "ffc": QuantitySpec(unit="", units={"": 1.0, "-": 1.0}, range=(0.0, 1e6)),
     },
     "aor": {
-        "angle_of_repose": QuantitySpec(**_ANGLE, conditions=(), noise=("abs", 0.5)),
+        "angle_of_repose": QuantitySpec(**_ANGLE, conditions=(), noise=("abs", 0.5), zero_ok=True),
         "bulk_density": QuantitySpec(**_DENSITY, conditions=()),
     },
     "poured": {"bulk_density": QuantitySpec(**_DENSITY, conditions=())},

@@ -10,12 +10,17 @@ values and the truth; only the lab noise is drawn here):
 
     .venv/bin/python scripts/make_synthetic_material.py --journal studies/results/dem_sets_default.jsonl \\
         --set 1 --preset default --name synthetic_cohesive --out data/measurements/synthetic_cohesive.csv
+
+--particle-density writes the same material at another particle density (by similarity,
+calibration/similarity.py: bulk densities, flow rates and pre-shear stresses times rho / 2500) with
+its `particle_density` row; --sieve adds a sieve table ("lower size mm:mass fraction,...").
 """
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +30,7 @@ sys.path.insert(0, str(ROOT))
 
 from pydem.calibration import synthetic  # noqa: E402
 from pydem.calibration.setup import load_setup, shipped_stores  # noqa: E402
+from pydem.quantity_table import metric_spec  # noqa: E402
 
 
 def main() -> int:
@@ -39,6 +45,8 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--journal", help="take the rigs' values and the truth from this diagnosis_dem_sets.py journal")
     ap.add_argument("--set", type=int, default=0, help="the journal's line (0-based)")
+    ap.add_argument("--particle-density", type=float, help="kg/m^3: the material at this particle density (similarity)")
+    ap.add_argument("--sieve", help="a sieve table, 'lower sieve size in mm (or pan):mass fraction retained,...'")
     a = ap.parse_args()
     stores = [ROOT / s for s in shipped_stores(a.preset)]
     setup = load_setup([s for s in stores if s.exists()])
@@ -57,7 +65,19 @@ def main() -> int:
             + (f"{a.effect} = {a.strength:g} switched on" if a.effect else "no hidden effect")
             + f", lab noise added (2 % friction coefficients, 1 % bulk density, 0.5 deg angle, 2 % hopper); "
               f"command: {' '.join(sys.argv)}")
-    synthetic.to_csv(a.out, a.name, obs, truth, note)
+    material_rows = []
+    if a.particle_density:
+        k = a.particle_density / next(iter(setup.stores.values())).spec.config({}).params.density
+        obs = [replace(o, value=o.value * (k if metric_spec(o.quantity.metric).scales_with_density else 1.0),
+                       uncertainty=o.uncertainty * (k if metric_spec(o.quantity.metric).scales_with_density else 1.0),
+                       conditions={c: v * k if c == "preshear_stress" else v for c, v in o.conditions.items()})
+               for o in obs]
+        material_rows.append(f"particle_density,{a.particle_density:g},kg/m^3,")
+        note += f"; at particle density {a.particle_density:g} kg/m^3 by similarity"
+    for item in (a.sieve.split(",") if a.sieve else []):
+        size, frac = item.split(":")
+        material_rows.append(f"sieve_retained,{frac},,sieve_mm={size}")
+    synthetic.to_csv(a.out, a.name, obs, truth, note, material_rows)
     print(f"{len(obs)} rows -> {a.out}")
     return 0
 

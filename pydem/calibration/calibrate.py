@@ -98,7 +98,7 @@ def row_notes(observations: list[Observation]) -> list[str]:
         if o.assumed:
             notes.append(f"{o.label}: condition(s) not given, assumed " + ", ".join(f"{k}={v:g}" for k, v in o.assumed.items()))
         for text in o.extrapolated.values():
-            notes.append(f"{o.label}: compared a little past the campaign's runs: {text} (the surrogate extrapolates)")
+            notes.append(f"{o.label}: compared a little past the campaign's declared range: {text} (the surrogate extrapolates)")
         if o.ignored:
             notes.append(f"{o.label}: condition(s) " + ", ".join(f"{k}={v}" for k, v in o.ignored.items())
                          + " not taken by the surrogate: compared with the campaign preset as it is")

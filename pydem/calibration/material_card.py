@@ -55,6 +55,13 @@ def card(material: str, setup, fit, candidates, verdict: str, verdict_line: str,
         caveats.append(f"scaled from the stores' particle density {scaling.store_density:g} kg/m^3 by similarity "
                        f"(docs/diagnosis.md §1): density, Young's modulus and cohesion energy density in this "
                        f"material's terms")
+    coh = params.get("effects.cohesion_sjkr.cohesion_energy_density")
+    if scaling is not None and coh is not None:  # Bo = k_c / (rho_p g d): the dimensionless cohesion the stores serve
+        coh["bond_number"] = scaling.bond_number(coh["value"] * scaling.factor)
+    if scaling is not None and scaling.material.mean_diameter is not None:
+        sizes = ", ".join(f"{rig} {1e3 * d:.3g} mm" for rig, d in sorted(scaling.store_diameters.items()))
+        caveats.append(f"the model's spheres are the stores' coarse-grained ones ({sizes}), not the material's "
+                       f"{1e3 * scaling.material.mean_diameter:.4g} mm mean: give the particles those sizes")
     return {"material": material, "verdict": verdict, "caveats": caveats, "models": {"normal": "Hertz", "damping": "restitution-based (seed 000)",
                                              "tangential": "Mindlin history, Coulomb cap", "rolling": fixed.rolling_model,
                                              "effects": sorted({c.name for c in candidates if c.parameter.startswith("effects.")})},

@@ -45,7 +45,7 @@ class Observation:
     # "lab": a lab's measurement, its uncertainty the lab's repeatability; "dem": one DEM run, which
     # also carries that run's seed scatter (measurements.ORIGINS; fit.row_noise)
     origin: str = "lab"
-    extrapolated: dict[str, str] = field(default_factory=dict)  # conditions a little past the runs (setup.EXTRAPOLATE)
+    extrapolated: dict[str, str] = field(default_factory=dict)  # conditions a little past the campaign's declared range (setup.RANGE_TOLERANCE)
 
     def condition_text(self) -> str:
         return ", ".join(f"{k}={v:g}" + (" (assumed)" if k in self.assumed else "") for k, v in self.conditions.items())

@@ -389,6 +389,22 @@ def glossary_section(terms: dict) -> tuple[str, str, str]:
             "<ul>" + "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(v)}</li>" for k, v in terms.items()) + "</ul>")
 
 
+def material_text(material: dict) -> str:
+    """The material as its file gave it and as the comparison took it (similarity.Scaling.as_dict)."""
+    rho_s = material.get("store_particle_density", float("nan"))
+    given = {k: v for k, v in (material.get("given") or {}).items() if v not in (None, [])}
+    if not given:
+        return f"not described: the stores' material assumed (particle density {rho_s:.6g} kg/m^3)"
+    parts = [f"sieve table of {len(v)} classes" if k == "sieve" else f"{k} {v:.6g}" for k, v in given.items()]
+    text = ", ".join(parts) + f"; compared with stores at particle density {rho_s:.6g} kg/m^3, scale {material.get('factor', 1.0):.4g}"
+    if material.get("mean_diameter") is not None:
+        text += f"; mean diameter {1e3 * material['mean_diameter']:.4g} mm, stores' spheres " + ", ".join(
+            f"{rig} {1e3 * d:.3g} mm" for rig, d in sorted((material.get("store_diameters") or {}).items()))
+    if material.get("size_spread") is not None:
+        text += f"; size spread {material['size_spread']:.3g}"
+    return text
+
+
 def provenance_section(context: dict) -> tuple[str, str, str]:
     """What made this report: pydem, libdem, commit, machine, command, time, the measurement file and
     every store (its path, runs and the libdem that ran them)."""
@@ -397,11 +413,7 @@ def provenance_section(context: dict) -> tuple[str, str, str]:
     if context.get("measurements"):
         rows.append(["measurement file", context["measurements"]])
     material = context.get("material") or {}
-    given = {k: v for k, v in (material.get("given") or {}).items() if v is not None}
-    rows.append(["the material (its file's `material` rows)", ", ".join(f"{k} {v:.6g}" for k, v in given.items())
-                 + f"; compared with stores at particle density {material.get('store_particle_density', 0):.6g} kg/m^3, "
-                   f"scale {material.get('factor', 1.0):.4g}" if given else f"not described: the stores' material "
-                 f"assumed (particle density {material.get('store_particle_density', float('nan')):.6g} kg/m^3)"])
+    rows.append(["the material (its file's `material` rows)", material_text(material)])
     for rig, s in (context.get("stores") or {}).items():
         rows.append([f"store ({rig})", f"{s['path']} (made by commit {s.get('commit')}, libdem {s.get('libdem')})"
                      + (f"; pooled: {', '.join(s['pooled'])}" if s.get("pooled") else "")])

@@ -51,16 +51,29 @@ class Setup:
     defaults: dict = field(default_factory=dict)  # condition -> preset value (rows that do not give it)
     pooled: dict = field(default_factory=dict)    # rig -> the stores pooled into its surrogates
 
-    def scaling(self, measurements: list) -> Scaling:
+    def scaling(self, material: MaterialProperties) -> Scaling:
         """How a material's rows are compared with these stores (similarity.py): its particle
-        density against theirs."""
+        density, size and modulus against theirs."""
         params = next(iter(self.stores.values())).spec.config({}).params
-        return Scaling(MaterialProperties.from_rows(measurements), float(params.density), float(params.youngs_modulus))
+        sizes = {rig: store_diameter(st.spec.config({})) for rig, st in self.stores.items()}
+        return Scaling(material, float(params.density), float(params.youngs_modulus), sizes)
+
+    def for_material(self, scaling: Scaling) -> "Setup":
+        """This setup with the material's size spread as the base model's (Scaling.candidates)."""
+        return dataclasses.replace(self, candidates=scaling.candidates(self.candidates, self.ranges))
 
     def store_provenance(self) -> dict:
         """{rig: path, commit and libdem of its store, and the paths of the stores pooled in}, for reports."""
         return {r: {"path": str(s.path), "commit": s.provenance.get("git_commit"), "libdem": s.provenance.get("libdem"),
                     "pooled": [str(o.path) for o in self.pooled.get(r, [])]} for r, s in self.stores.items()}
+
+
+def store_diameter(cfg) -> float:
+    """The mass-mean sphere diameter of a rig's configuration: its `diameter`, or the hopper's two
+    species weighted by the fine volume fraction."""
+    if hasattr(cfg, "diameter"):
+        return float(cfg.diameter)
+    return float(cfg.fine_fraction * cfg.d_small + (1.0 - cfg.fine_fraction) * cfg.d_large)
 
 
 def _relative_volume(store, stores) -> float:
@@ -126,10 +139,17 @@ def observations_from_file(path: str | Path, material: str, setup: Setup) -> tup
     return observations_of(load_measurements(path, material), setup, str(path), material)
 
 
-# how far past a campaign's runs a condition is still compared (a fraction of the range): the
-# design's extreme points stop short of the spec's ends (a 0.5-10 kPa box ran 500.8-9997 Pa), and
-# seed 000's own programme pre-shears at 10.07 kPa; a smooth net moves little over 5 %
-EXTRAPOLATE = 0.05
+# how far past a campaign's declared range a condition is still compared (a fraction of the range):
+# a smooth net moves little over 2 %, and labs round (seed 000's programme pre-shears at 10.07 kPa)
+RANGE_TOLERANCE = 0.02
+
+
+def declared_range(setup: Setup, rig: str, condition: str) -> tuple[float, float] | None:
+    """The range of a condition that the rig's campaigns declare (the main store's and those pooled
+    into it, joined): a condition inside it is inside the stores, whatever the design's extreme points."""
+    spans = [st.spec.ranges[condition] for st in [setup.stores[rig], *setup.pooled.get(rig, [])]
+             if condition in st.spec.ranges]
+    return (min(a for a, _ in spans), max(b for _, b in spans)) if spans else None
 
 
 def observations_of(measurements: list, setup: Setup, source: str, material: str,
@@ -138,14 +158,18 @@ def observations_of(measurements: list, setup: Setup, source: str, material: str
     (measurements.load), read from `source`, compared with the stores through `scaling` (default:
     setup.scaling of these rows)."""
     rows = [m for m in measurements if m.use == "calibrate" and m.test != MATERIAL_TEST]
-    scaling = scaling if scaling is not None else setup.scaling(measurements)
-    scaled = " (scaled to the stores' particle density)" if scaling.factor != 1.0 else ""
+    scaling = scaling if scaling is not None else setup.scaling(MaterialProperties.from_rows(measurements))
     out, skipped = [], []
     for m in rows:
         try:
-            o = scaling.observation(observation(m, setup.defaults))
+            o = observation(m, setup.defaults)
         except ObservationError as exc:
             skipped.append(str(exc))
+            continue
+        try:
+            o = scaling.observation(o)
+        except ObservationError as exc:
+            skipped.append(f"line {m.line}: {exc}")
             continue
         if o.quantity not in setup.nets:
             skipped.append(f"line {m.line}: {m.label}: no campaign store offers {o.quantity.key} "
@@ -156,15 +180,16 @@ def observations_of(measurements: list, setup: Setup, source: str, material: str
         for k, v in o.conditions.items():
             if k not in net.input_names:
                 continue
-            lo, hi = net.lo[net.input_names.index(k)], net.hi[net.input_names.index(k)]
+            span = declared_range(setup, o.quantity.rig, k)
+            lo, hi = span if span else (net.lo[net.input_names.index(k)], net.hi[net.input_names.index(k)])
             past = max(lo - v, v - hi, 0.0) / (hi - lo)
-            if past > EXTRAPOLATE:
+            if past > RANGE_TOLERANCE:
                 outside.append(f"{k}={v:g} outside [{lo:g}, {hi:g}]")
             elif past > 0:
-                near.append((k, f"{k}={v:g} lies {100 * past:.1f} % of the range past the runs' [{lo:g}, {hi:g}]"))
+                near.append((k, f"{k}={v:g} lies {100 * past:.1f} % of the range past the campaign's [{lo:g}, {hi:g}]"))
         if outside:
-            skipped.append(f"line {m.line}: {m.label}: condition {', '.join(outside)} (the campaign's range, "
-                           f"{100 * EXTRAPOLATE:g} % past it allowed){scaled}")
+            skipped.append(f"line {m.line}: {m.label}: condition {', '.join(outside)} (the campaign's declared range, "
+                           f"{100 * RANGE_TOLERANCE:g} % past it allowed){scaling.condition_note(o)}")
             continue
         if near:
             o = dataclasses.replace(o, extrapolated=dict(near))

@@ -237,14 +237,18 @@ def journal_set(row: dict, nets: dict, candidates: list[Candidate], rng: np.rand
                                  row_inputs(nets, candidates, truth, obs))
 
 
-def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str):
-    """A measurement file (docs/measurements.md) of a pseudo-measurement set, its truth in comments."""
+def to_csv(path, material: str, obs: list[Observation], truth: Truth, note: str, material_rows: list[str] = ()):
+    """A measurement file (docs/measurements.md) of a pseudo-measurement set, its truth in comments;
+    material_rows: rows of test `material` (quantity,value,unit,conditions) that describe it."""
     lines = [f"# {note}", f"# truth: {truth.theta}; effect {truth.effect} {truth.parameter} = {truth.strength}",
              "material,test,quantity,value,uncertainty,unit,conditions,use,source,origin"]
     for o in obs:
         cond = ";".join(f"{k}={v:.6g}" for k, v in o.conditions.items())
         lines.append(f"{material},{TEST_OF_RIG[o.quantity.rig]},{o.quantity.metric},{o.value:.8g},{o.uncertainty:.6g},,"
                      f"{cond},calibrate,synthetic,{o.origin}")
+    for row in material_rows:
+        q, v, unit, cond = row.split(",")
+        lines.append(f"{material},material,{q},{v},,{unit},{cond},,synthetic,")
     from pathlib import Path
     Path(path).write_text("\n".join(lines) + "\n")
 

@@ -272,21 +272,26 @@ def test_calibrate_screens_on_the_threads_omp_num_threads_gives():
     assert load_inputs(args, "calibrate", lambda *a: None) is None
 
 
-def test_a_condition_a_little_past_the_runs_is_used_and_said(tiny, tmp_path):
-    """A design's extreme points stop short of its spec's ends (seed 000 pre-shears at 10.07 kPa, the
-    default store's runs end at 9.997 kPa): up to 5 % of the range past the runs a row is compared,
-    with a note that the surrogate extrapolates; further out it is left out, saying the limit."""
+def test_a_condition_is_inside_the_store_when_inside_its_declared_range(tiny, tmp_path):
+    """Inside means inside the campaign's declared range, not between the design's extreme points
+    (a 0.5-10 kPa box ran 500.8-9997 Pa): a row at the range's end is compared without a note; up to
+    2 % of the range past it a row is compared with a note that the surrogate extrapolates; further
+    out it is left out, saying the limit."""
     from pydem.calibration.calibrate import row_notes
-    from pydem.calibration.setup import EXTRAPOLATE, observations_of
+    from pydem.calibration.setup import RANGE_TOLERANCE, declared_range, observations_of
     from pydem.measurements import load
     q = next(q for q in tiny.nets if q.rig == "ring-shear" and q.metric == "mu_ie_ps")
     net = tiny.nets[q]
-    lo, hi = (x[net.input_names.index("preshear_stress")] for x in (net.lo, net.hi))
+    lo, hi = declared_range(tiny, "ring-shear", "preshear_stress")
+    assert (lo, hi) == tuple(tiny.stores["ring-shear"].spec.ranges["preshear_stress"])
+    assert net.hi[net.input_names.index("preshear_stress")] < hi  # the design's last point stops short
     f = tmp_path / "m.csv"
     f.write_text("material,test,quantity,value,uncertainty,unit,conditions\n"
-                 f"m,ring_shear,mu_ie_ps,0.55,0.01,,preshear_stress={hi + 0.02 * (hi - lo):.6g}\n"
-                 f"m,ring_shear,mu_ie_ps,0.55,0.01,,preshear_stress={hi + 2 * EXTRAPOLATE * (hi - lo):.6g}\n")
+                 f"m,ring_shear,mu_ie_ps,0.55,0.01,,preshear_stress={hi:.8g}\n"
+                 f"m,ring_shear,mu_ie_ps,0.56,0.01,,preshear_stress={hi + 0.5 * RANGE_TOLERANCE * (hi - lo):.8g}\n"
+                 f"m,ring_shear,mu_ie_ps,0.57,0.01,,preshear_stress={hi + 2 * RANGE_TOLERANCE * (hi - lo):.8g}\n")
     obs, skipped = observations_of(load(f, "m"), tiny, "m.csv", "m")
-    assert len(obs) == 1 and "2.0 % of the range past the runs" in obs[0].extrapolated["preshear_stress"]
+    assert len(obs) == 2 and not obs[0].extrapolated
+    assert "1.0 % of the range past the campaign's" in obs[1].extrapolated["preshear_stress"]
     assert any("the surrogate extrapolates" in n for n in row_notes(obs))
-    assert len(skipped) == 1 and "5 % past it allowed" in skipped[0]
+    assert len(skipped) == 1 and "line 4" in skipped[0] and "2 % past it allowed" in skipped[0]
