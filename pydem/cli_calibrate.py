@@ -58,6 +58,9 @@ def main(args) -> int:
     c = calibrate(args.material, obs, setup.nets, setup.ranges, setup.candidates, args.window, args.samples,
                   args.threads, say)
     c.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes(setup.ranges)]
+    from .calibration.reach import name_campaigns
+    for line in name_campaigns(c.reach, setup.stores, {o.quantity.rig for o in obs}):
+        say(f"  at an edge: {line}")
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
                "stores": setup.store_provenance(), "window": args.window, "samples": args.samples,

@@ -38,6 +38,9 @@ def main(args) -> int:
         print(f"pydem diagnose: {exc}", file=sys.stderr)
         return 2
     d.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes(setup.ranges)]
+    from .calibration.reach import name_campaigns
+    for line in name_campaigns(d.reach, setup.stores, {o.quantity.rig for o in obs}):
+        say(f"  at an edge: {line}")
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
                "stores": setup.store_provenance(), "libdem_of_stores": setup.physics, "material": scaling.as_dict()}

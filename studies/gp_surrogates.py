@@ -62,7 +62,7 @@ def gp_predict(xtr, ytr, xte):
 def main() -> int:
     paths = [Path(p) for p in sys.argv[1:]] or [ROOT / s for s in DEFAULT_STORES]
     nets = load_setup(paths, say=lambda *_: None).nets
-    for rig, (store, pooled) in open_store_groups(paths).items():
+    for rig, (store, pooled, _) in open_store_groups(paths).items():
         for q, (names, x, y) in training_tables(store, pooled).items():
             xs = Scaler.fit(x).forward(x)
             _, g = np.unique(x[:, :len(store.spec.names)], axis=0, return_inverse=True)

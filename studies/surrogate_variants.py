@@ -34,7 +34,7 @@ def main() -> int:
     ap.add_argument("--stores", nargs="+", default=[str(ROOT / s) for s in DEFAULT_STORES])
     args = ap.parse_args()
     torch.set_num_threads(1)
-    main_store, pooled = open_store_groups(args.stores)["ring-shear"]
+    main_store, pooled, _ = open_store_groups(args.stores)["ring-shear"]
     lines = [f"# {time.strftime('%Y-%m-%d')}, {main_store.path.name} ({(main_store.status == 1).sum()} runs) + "
              + ", ".join(f"{o.path.name} ({(o.status == 1).sum()})" for o in pooled) + "; 5-fold CV R^2 / RMSE"]
     for q, (names, x, y) in training_tables(main_store, pooled).items():

@@ -6,7 +6,12 @@ the diagnosis store's box: each parameter it did not vary had the value its pres
 effect that was off: the effect's neutral value). Its runs therefore train the same surrogates,
 once mapped into the diagnosis store's parameter columns. Stores are pooled only when that
 mapping is exact: same rig, preset, rig protocol and physics, the same resolved configuration
-apart from the varied keys, and every fixed value inside the diagnosis store's ranges."""
+apart from the varied keys, and every fixed value inside the diagnosis store's ranges.
+
+A store may also extend the box: a slab past one edge (pre-shear 10-20 kPa beside a 0.5-10 kPa
+store, every other range the same) spends its runs only where the box grows. The rig's box is then
+the stores' joined ranges, provided their boxes fill it together — a corner that no store ran would
+be extrapolation that the box claims to cover (joined_box)."""
 from __future__ import annotations
 
 import numpy as np
@@ -47,10 +52,34 @@ def check_poolable(main, other) -> None:
         lo, hi = main.spec.ranges[name]
         if not lo <= v <= hi:
             raise PoolError(f"{where}: its {name} = {v:g} lies outside {main.path.name}'s range [{lo:g}, {hi:g}]")
-    for name, (lo, hi) in other.spec.ranges.items():
-        mlo, mhi = main.spec.ranges[name]
-        if lo < mlo or hi > mhi:
-            raise PoolError(f"{where}: its {name} range [{lo:g}, {hi:g}] exceeds [{mlo:g}, {mhi:g}]")
+
+
+def joined_box(main, others) -> dict[str, tuple[float, float]]:
+    """The box a rig's stores cover together: `main`'s ranges, joined with those of the stores that
+    extend them. Raises PoolError when the boxes of the stores that vary every parameter (designs over
+    the whole box, not held on axes) leave part of the joined box without runs."""
+    names = list(main.spec.ranges)
+    box = {n: tuple(main.spec.ranges[n]) for n in names}
+    for o in others:
+        for n, (lo, hi) in o.spec.ranges.items():
+            box[n] = (min(box[n][0], lo), max(box[n][1], hi))
+    if box == {n: tuple(main.spec.ranges[n]) for n in names}:
+        return box
+    full = [st for st in [main, *others] if set(st.spec.ranges) == set(names) and not st.spec.neutral]
+    width = np.array([box[n][1] - box[n][0] for n in names])
+    los = np.array([[st.spec.ranges[n][0] for n in names] for st in full])
+    his = np.array([[st.spec.ranges[n][1] for n in names] for st in full])
+    covered = 0.0  # the union's volume (relative to the joined box) by inclusion-exclusion
+    for mask in range(1, 2 ** len(full)):
+        idx = [i for i in range(len(full)) if mask >> i & 1]
+        side = np.clip(his[idx].min(axis=0) - los[idx].max(axis=0), 0.0, None) / np.where(width > 0, width, 1.0)
+        covered += (-1) ** (len(idx) + 1) * float(np.prod(side))
+    if covered < 1.0 - 1e-9:
+        grown = ", ".join(f"{n} [{box[n][0]:g}, {box[n][1]:g}]" for n in names if box[n] != tuple(main.spec.ranges[n]))
+        raise PoolError(f"the stores of {main.path.name}'s rig leave {100 * (1 - covered):.3g} % of their joined box "
+                        f"({grown}) without runs: an extending store must span every other range of the box "
+                        f"(a slab past one edge)")
+    return box
 
 
 def pooled_params(main, other) -> np.ndarray:

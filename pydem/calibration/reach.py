@@ -10,6 +10,8 @@ problem. An edge counts when that gain is at least REACH_CHI2 (one σ's worth): 
 within what the noise moves."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from scipy import optimize
 
@@ -64,6 +66,25 @@ def held_back(model: Model, fit: Fit) -> list[dict]:
     return out
 
 
+def name_campaigns(reach: list[dict], stores: dict, rigs: set) -> list[str]:
+    """Adds to each held-back parameter the campaigns (their TOML files) whose range for it would have
+    to go past the edge: the main store of each rig the measurements use; returns one line per parameter."""
+    def shown(path: Path) -> str:
+        try:
+            return str(path.resolve().relative_to(Path.cwd()))
+        except ValueError:
+            return str(path)
+    lines = []
+    for r in reach:
+        r["campaigns"] = [shown(st.path.with_suffix(".toml")) for rig, st in sorted(stores.items())
+                          if rig in rigs and r["parameter"] in st.spec.ranges]
+        if r["campaigns"]:
+            way = "above" if r["edge"] == "upper" else "below"
+            lines.append(f"{r['parameter']} stops at its {r['edge']} edge {r['value']:g}: extend {', '.join(r['campaigns'])} "
+                         f"{way} it (a campaign over the wider box, this store pooled into it: docs/diagnosis.md §2)")
+    return lines
+
+
 def sentence(reach: list[dict]) -> str:
     """The plain-words account of held_back's list: how far, and what could reach it."""
     if not reach:
@@ -77,4 +98,6 @@ def sentence(reach: list[dict]) -> str:
             f"{max(r['gain'] for r in reach):.1f} to first order): {row['label']} measured {row['measured']:.4g}, "
             f"the model reaches {row['model']:.4g} ({row['residual']:+.3g}{(' ' + unit) if unit else ''}, "
             f"{row['z']:+.1f} σ). A campaign whose range goes {past}, or an effect that moves this quantity, could "
-            f"reach it; within this box the parameters are bounds, not estimates.")
+            f"reach it; within this box the parameters are bounds, not estimates." + "".join(
+                f" Campaigns to extend for {r['parameter'].split('.')[-1]}: {', '.join(r['campaigns'])}."
+                for r in reach if r.get("campaigns")))

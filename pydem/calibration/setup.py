@@ -12,7 +12,7 @@ from ..campaign import Campaign
 from ..campaign.store import check_same_physics
 from ..measurements import load as load_measurements
 from .candidates import BASE_PARAMETERS, Candidate, registry
-from .pooled_runs import check_poolable
+from .pooled_runs import check_poolable, joined_box
 from .quantities import Observation, ObservationError, observation
 from .similarity import MATERIAL_TEST, MaterialProperties, Scaling
 from .store_data import preset_conditions, replicate_stores
@@ -87,10 +87,11 @@ def _relative_volume(store, stores) -> float:
 
 
 def open_store_groups(paths) -> dict:
-    """{rig: (main store, [stores pooled into it])}: per rig the store that varies the most
-    parameters over the largest box (in units of each range's own width: the product of the
-    widths relative to the union box) is the main one; every other store of that rig must be
-    poolable into it (pooled_runs.py, else a PoolError naming why)."""
+    """{rig: (main store, [stores pooled into it], the box they cover together)}: per rig the store
+    that varies the most parameters over the largest box (in units of each range's own width: the
+    product of the widths relative to the union box) is the main one; every other store of that rig
+    must be poolable into it (pooled_runs.py, else a PoolError naming why), and stores that extend
+    its box must fill the joined box together (pooled_runs.joined_box)."""
     by_rig = {}
     for p in paths:
         st = Campaign.open(p).store
@@ -104,18 +105,18 @@ def open_store_groups(paths) -> dict:
         others = [st for st in sts if st is not main]
         for o in others:
             check_poolable(main, o)
-        groups[rig] = (main, others)
+        groups[rig] = (main, others, joined_box(main, others))
     return groups
 
 
 def open_stores(paths) -> dict:
     """{rig: the main store of the rig} (open_store_groups)."""
-    return {rig: main for rig, (main, _) in open_store_groups(paths).items()}
+    return {rig: main for rig, (main, _, _) in open_store_groups(paths).items()}
 
 
 def load_setup(paths, say=print, retrain: bool = False) -> Setup:
     groups = open_store_groups(paths)
-    stores = {rig: main for rig, (main, _) in groups.items()}
+    stores = {rig: main for rig, (main, _, _) in groups.items()}
     physics = check_same_physics(stores.values(), "diagnose with")
     nets, ranges, defaults = {}, {}, {}
     for rig, st in stores.items():
@@ -125,13 +126,13 @@ def load_setup(paths, say=print, retrain: bool = False) -> Setup:
         rig_nets = load_or_train(st, say, retrain, pooled=groups[rig][1])
         attach_run_correlations(list(rig_nets.values()), replicate_stores(st, groups[rig][1]), say=lambda *a: None)
         nets.update(rig_nets)
-        for name, (lo, hi) in st.spec.ranges.items():
+        for name, (lo, hi) in groups[rig][2].items():
             if name in ranges:
                 lo, hi = max(lo, ranges[name][0]), min(hi, ranges[name][1])
             ranges[name] = (lo, hi)
         defaults.update(preset_conditions(st))
     cands = [c for c in registry() if c.parameter in ranges]
-    return Setup(stores, nets, ranges, cands, physics, defaults, {r: others for r, (_, others) in groups.items()})
+    return Setup(stores, nets, ranges, cands, physics, defaults, {r: others for r, (_, others, _) in groups.items()})
 
 
 def observations_from_file(path: str | Path, material: str, setup: Setup) -> tuple[list[Observation], list[str]]:

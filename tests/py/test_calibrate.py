@@ -186,7 +186,14 @@ def test_shipped_measurements():
     m = load(ROOT / "data/measurements/glass_microbeads.csv", "glass_microbeads")
     assert [x.metric for x in m] == ["mu_ie_ps", "mu_ie_s_50", "bulk_density"]
     assert abs(m[0].value - np.tan(np.radians(23.45))) < 1e-4  # converted from the published angle
-    assert len(load(ROOT / "data/measurements/jku_angle_of_repose.csv")) == 8
+    jku = load(ROOT / "data/measurements/jku_angle_of_repose.csv")
+    angles = [x for x in jku if x.test == "aor"]
+    assert len(angles) == 8
+    # each material's sieve table gives the mean diameter the JKU reduction published beside its angle
+    from pydem.calibration.similarity import MaterialProperties
+    for a in angles:
+        mat = MaterialProperties.from_rows([x for x in jku if x.material == a.material])
+        assert 1e3 * mat.mean_diameter == pytest.approx(float(a.conditions["mean_diameter_mm"]), abs=0.006), a.material
 
 
 def test_command_line_errors_are_clear(tmp_path):

@@ -7,6 +7,8 @@ import math
 import subprocess
 import sys
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -622,8 +624,16 @@ def test_measurements_past_the_box_are_out_of_reach_not_consistent():
     free = minimise(Model(data, nets, wide, CANDS, at=d.base.best), start=d.base.best)
     drop = Model(data, nets, RANGES, CANDS, at=d.base.best).chi2(d.base.best) - free.chi2
     assert free.best[0] > 1.03 and d.reach[0]["gain"] == pytest.approx(drop, rel=0.1), (d.reach, drop)
+    # the campaign that would move it: the main store of each rig the rows use that varies friction
+    from types import SimpleNamespace
+    from pydem.calibration.reach import name_campaigns
+    store = lambda path, names: SimpleNamespace(path=Path(path), spec=SimpleNamespace(ranges=dict.fromkeys(names)))  # noqa: E731
+    stores = {"aor": store("/x/diag_aor.h5", ["friction"]), "hopper": store("/x/diag_hopper.h5", ["friction"]),
+              "ring-shear": store("/x/diag_rs.h5", ["restitution"])}
+    lines = name_campaigns(d.reach, stores, {"aor", "ring-shear"})
+    assert d.reach[0]["campaigns"] == ["/x/diag_aor.toml"] and "extend /x/diag_aor.toml above it" in lines[0]
     from pydem.calibration.report import verdict_line
-    assert "friction at its upper edge 1" in verdict_line(d)
+    assert "friction at its upper edge 1" in verdict_line(d) and "Campaigns to extend for friction: /x/diag_aor.toml" in verdict_line(d)
 
     three = [o for o in generate(nets, obs, (0.4, 0.5, 0.5), {}, np.random.default_rng(13))
              if o.conditions["condition"] == 0.5]

@@ -86,3 +86,21 @@ def test_a_hopper_that_did_not_empty_trains_no_discharge_metric():
     assert list(tables[Quantity("hopper", "mass_flow_rate")][2]) == [1.1]
     assert list(tables[Quantity("hopper", "discharge_time")][2]) == [1.2]
     assert list(tables[Quantity("hopper", "bulk_density")][2]) == [1300.0, 1250.0]
+
+
+def test_a_slab_past_one_edge_extends_the_box_and_a_corner_left_unrun_is_refused():
+    """A store over the same ranges but one, which continues past the main store's edge (wall friction
+    1.0-1.2 beside 0.05-1.0), extends the rig's box; two slabs that leave a corner unrun (wall
+    friction 1.0-1.2 only at low friction, friction 1.0-1.2 only at low wall friction) do not
+    fill their joined box, and say how much of it is missing: (0.2 / 1.15)^2 = 3.02 %."""
+    from pydem.calibration.pooled_runs import joined_box
+    main = store("six.h5", BOX, [[0.5, 0.3, 0.5, 0.4, 2e4, 0.2]], [[35.0, 1500.0]])
+    slab = store("slab.h5", {**BOX, "wall_friction": (1.0, 1.2)}, [[0.5, 0.3, 0.5, 1.1, 2e4, 0.2]], [[36.0, 1500.0]])
+    check_poolable(main, slab)
+    box = joined_box(main, [slab])
+    assert box["wall_friction"] == (0.05, 1.2) and box["friction"] == BOX["friction"]
+    assert joined_box(main, []) == {n: tuple(r) for n, r in BOX.items()}
+    gap = store("gap.h5", {**BOX, "friction": (1.0, 1.2)}, [[1.1, 0.3, 0.5, 0.4, 2e4, 0.2]], [[36.0, 1500.0]])
+    with pytest.raises(PoolError, match=r"leave 3\.02 % of their joined box \(friction \[0.05, 1.2\], "
+                                        r"wall_friction \[0.05, 1.2\]\) without runs"):
+        joined_box(main, [slab, gap])
