@@ -60,6 +60,7 @@ class Model:
         self.y = np.array([o.value for o in observations])
         self._whiten = None  # L^-1, made on first use (a model only asked for predictions needs no noise)
         self._maps = [self._affine_map(o, n) for o, n in zip(observations, self.nets)]
+        self._groups = self._net_groups()
         self.at = None if at is None else np.asarray(at, dtype=float)
         self._seed, self._err, self.sigma = self._row_errors()
 
@@ -141,18 +142,34 @@ class Model:
         c, a = self._maps[k]
         return c + np.atleast_2d(p) @ a.T
 
+    def _net_groups(self) -> list:
+        """[(net, its rows, C (r, inputs), A (r, inputs, k))]: the rows of one net evaluated in one call
+        (a net's cost is per call far more than per row)."""
+        groups = {}
+        for k, net in enumerate(self.nets):
+            groups.setdefault(id(net), (net, []))[1].append(k)
+        out = []
+        for net, rows in groups.values():
+            out.append((net, np.array(rows), np.array([self._maps[k][0] for k in rows]),
+                        np.array([self._maps[k][1] for k in rows]).reshape(len(rows), -1, len(self.free))))
+        return out
+
     def predict(self, p: np.ndarray) -> np.ndarray:
         """p: (m, k) or (k,) -> predictions (m, n) or (n,)."""
         p2 = np.atleast_2d(p)
-        out = np.column_stack([net(c + p2 @ a.T) for net, (c, a) in zip(self.nets, self._maps)])
+        out = np.empty((len(p2), len(self.nets)))
+        for net, rows, c, a in self._groups:
+            x = c[None] + np.einsum("mk,rik->mri", p2, a)
+            out[:, rows] = net(x.reshape(-1, x.shape[-1])).reshape(len(p2), len(rows))
         return out[0] if np.ndim(p) == 1 else out
 
     def jacobian(self, p: np.ndarray) -> np.ndarray:
         """(n, k): d prediction / d free parameters at p."""
-        rows = []
-        for net, (c, a) in zip(self.nets, self._maps):
-            rows.append(net.gradient((c + a @ p)[None, :])[0] @ a)
-        return np.array(rows)
+        out = np.empty((len(self.nets), len(self.free)))
+        for net, rows, c, a in self._groups:
+            g = net.gradient(c + a @ p)
+            out[rows] = np.einsum("ri,rik->rk", g, a)
+        return out
 
     def net_jacobian(self, p: np.ndarray, parameter: str) -> np.ndarray:
         """(n,): d prediction / d (net input `parameter`) at p, the other inputs held (a
