@@ -334,13 +334,14 @@ def effect_sets(setup, n: int, seed: int = 0, net_error: bool = True, min_fracti
 
 
 def validate(setup, kinds: dict[str, int], seed: int = 0, source: str = "surrogate", threads: int = 1,
-             say=print, journal=None, net_error: bool = True) -> list[dict]:
+             say=print, journal=None, net_error: bool = True, base_obs: list[Observation] | None = None) -> list[dict]:
     """Runs the protocol: kinds = {"null": n, <candidate name>: n, "unexplained": n}; source
     "surrogate" or "dem" (net_error: surrogate sets carry a draw of the nets' own error, as
-    DEM-made ones do). One row per set: truth, verdict, chosen effect, errors before/after."""
+    DEM-made ones do); base_obs: the conditions (default: programme's grid). One row per set:
+    truth, verdict, chosen effect, errors before/after."""
     import json
     from pathlib import Path
-    base_obs = programme(setup.nets)
+    base_obs = programme(setup.nets) if base_obs is None else base_obs
     rows = []
     done = {}
     if journal is not None and Path(journal).exists():  # resumable: finished sets are kept, not redone
