@@ -16,7 +16,15 @@ from .cli_inputs import add_common, load_inputs, output_checked
 def add_parser(sub):
     p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
     add_common(p, "build/diagnosis")
+    p.add_argument("--refine", type=int, default=0, metavar="N",
+                   help="after the first pass, up to N DEM runs of the file's rigs where the surrogates' error decides "
+                        "the answer, the surrogates corrected by them, and the diagnosis again (runs kept, resumable, in "
+                        "<out>.refine; docs/diagnosis.md §8)")
+    p.add_argument("--workers", type=int, default=None, help="worker processes of the refinement runs (default: the cores)")
     p.set_defaults(func=main)
+
+
+MAX_REFINE = 4096
 
 
 def main(args) -> int:
@@ -26,10 +34,24 @@ def main(args) -> int:
     say = lambda msg: print(msg, flush=True)  # noqa: E731
     if not output_checked(args.out, "diagnose"):
         return 2
+    refine_dir = Path(str(args.out).rstrip("/") + ".refine")
+    if args.refine and (not 0 < args.refine <= MAX_REFINE or (refine_dir.exists() and not refine_dir.is_dir())
+                        or (args.workers is not None and args.workers < 1)):
+        print(f"pydem diagnose: --refine takes 1..{MAX_REFINE} runs, --workers at least 1, and {refine_dir} must be a "
+              f"directory or absent (got --refine {args.refine}, --workers {args.workers})", file=sys.stderr)
+        return 2
     loaded = load_inputs(args, "diagnose", say)
     if loaded is None:
         return 2
     setup, obs, skipped, scaling = loaded
+    runs = None
+    if args.refine:
+        from .calibration import refine
+        try:
+            runs = refine.saved_plan(refine_dir, obs, args.refine, setup.stores)
+        except (ValueError, OSError) as exc:
+            print(f"pydem diagnose: {exc}", file=sys.stderr)
+            return 2
     say(f"diagnosing {args.material}: {len(obs)} measurements, candidates "
         f"{', '.join(c.name for c in setup.candidates)} (stores: libdem {setup.physics})")
     try:
@@ -37,13 +59,25 @@ def main(args) -> int:
     except ValueError as exc:
         print(f"pydem diagnose: {exc}", file=sys.stderr)
         return 2
+    refinement = None
+    if args.refine:
+        if runs is None:
+            runs = refine.plan(d, obs, setup.nets, setup.candidates, setup.ranges, args.refine)
+            refine.save_plan(refine_dir, runs, obs, args.refine, setup.stores)
+        import os
+        entries = refine.run_plan(runs, setup.stores, refine_dir, args.workers or os.cpu_count() or 1, say)
+        nets = refine.corrected_nets(setup.nets, entries)
+        say(f"second pass, on the surrogates corrected by {sum('metrics' in e for e in entries)} runs:")
+        first, d = d, diagnose(args.material, obs, nets, setup.ranges, setup.candidates, say)
+        refinement = refine.summary(first, d, entries, nets, obs) | {"folder": str(refine_dir)}
     d.notes += [f"left out: {line}" for line in skipped] + [f"material: {line}" for line in scaling.notes(setup.ranges)]
     from .calibration.reach import name_campaigns
     for line in name_campaigns(d.reach, setup.stores, {o.quantity.rig for o in obs}):
         say(f"  at an edge: {line}")
     from .provenance import provenance
     context = {"provenance": provenance(), "measurements": str(args.measurements),
-               "stores": setup.store_provenance(), "libdem_of_stores": setup.physics, "material": scaling.as_dict()}
+               "stores": setup.store_provenance(), "libdem_of_stores": setup.physics, "material": scaling.as_dict(),
+               "refinement": refinement}
     if args.confirm:
         from .calibration.confirm import confirm
         from .progress import RunProgress

@@ -81,6 +81,11 @@ class Model:
         return seed, err, sigma
 
     @property
+    def net_errors(self) -> np.ndarray:
+        """(n,): each row's net-error term of its sigma (its surrogate's own error at the row)."""
+        return self._err
+
+    @property
     def cov(self) -> np.ndarray:
         return self._covariance()
 

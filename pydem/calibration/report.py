@@ -236,6 +236,8 @@ def write(d: Diagnosis, out: str | Path, context: dict | None = None) -> Path:
             "p-value — takes the noise model where it lands (the nets' error models vary over the campaign box)."
             if a else "")
     sections.append(("Before and after", md + (f"\n\n{note}" if note else ""), h + (f"<p>{html.escape(note)}</p>" if note else "")))
+    if data["context"].get("refinement"):
+        sections.append(refinement_section(data["context"]["refinement"]))
     rows = [[c.effect, c.parameter, _g(d.base.chi2, ".2f"), _g(c.fit.chi2, ".2f"),
              _g(c.statistic, ".2f"), _g(c.p_value, ".2g"), _g(c.delta_bic, ".1f"),
              _g(c.score, ".2f"), f"{_g(c.estimate)} {c.unit}".strip(), f"{_g(c.neutral)} {c.unit}".strip()]
@@ -342,6 +344,29 @@ def residual_section(rows: list[dict], title: str) -> tuple[str, str, str]:
               _g(r["z"], "+.2f")] for r in rows]
     md, h = page.table(table, ["measurement", "measured", "u", "model", "sigma (all)", "z"])
     return title, md, h
+
+
+def refinement_section(r: dict) -> tuple[str, str, str]:
+    """The two passes side by side, the runs, and each row's surrogate error against its measurement's
+    uncertainty before and after the refinement (refine.summary)."""
+    a, b = r["first_pass"], r["second_pass"]
+    names = list(a["estimate"])
+    rows = [[name, _g(p["chi2_per_dof"], ".2f"), p["verdict"] + (f" ({' + '.join(p['effects'])})" if p["effects"] else ""),
+             *[_g(p["estimate"][n], ".3g") for n in names]] for name, p in (("first pass (shipped stores)", a),
+                                                                             ("second pass (refined)", b))]
+    md1, h1 = page.table(rows, ["pass", "base chi^2/dof", "verdict", *names])
+    rows = [[x["label"], _g(x["uncertainty"]) if x["uncertainty"] is not None else "not given",
+             _g(x["net_error_first"]), _g(x["net_error_second"])] for x in r["rows"]]
+    md2, h2 = page.table(rows, ["measurement", "its uncertainty", "surrogate error, first pass", "after refinement"])
+    rows = [[q, v["runs"], _g(v["net_rmse"]), _g(v["corrected_loo_rmse"])] for q, v in r["quantities"].items()]
+    md3, h3 = page.table(rows, ["quantity", "runs", "global net's RMSE at the runs", "corrected, leave one out"])
+    failed = "; ".join(f"run {f['index']} ({f['rig']}): {f['error']}" for f in r["failed"]) or "none"
+    text = (f"{r['runs']} refinement runs ({r['cpu_seconds']:.0f} s of CPU; failed: {failed}), kept in {r['folder']}. "
+            f"The second pass uses the surrogates corrected by them (docs/diagnosis.md §8); the rest of this report is "
+            f"the second pass.")
+    md = "\n\n".join([text, md1, md2, md3])
+    h = f"<p>{html.escape(text)}</p>" + h1 + h2 + h3
+    return "Refinement: first and second pass", md, h
 
 
 def confirm_section(rows: list[dict]) -> tuple[str, str, str]:

@@ -1,0 +1,272 @@
+"""Refinement runs for one material (docs/diagnosis.md §8): after a first pass on the shipped
+stores, up to N DEM runs of the rigs the measurement file uses, placed where the surrogates'
+error decides the answer, then the surrogates corrected by them (local_correction.py) and the
+diagnosis run again.
+
+Where the runs go. What decides a diagnosis is the rows' σ, and near a material the net's error
+is most of it. The refinement therefore runs the rigs at the points whose predictions the verdict
+uses — the base model's estimate and draws from its posterior, each covered candidate at its
+refit's estimate and at its detection limit — at the measured conditions, and picks the runs one
+at a time, greedily, by how much each lowers the net-error variance summed over those target
+predictions, each weighted by 1 / σ_row² (its weight in χ²). The net-error variance left after a
+set of runs is the local correction's posterior variance, which does not depend on the runs'
+results, so the whole plan is made before any run (and a resumed refinement runs the same plan).
+A target picked twice is a replicate: the kernel's noise term (the run's seed scatter) gives it a
+smaller but real gain. The simple alternative — a fixed design over the posterior box — spends
+runs where no row is predicted.
+
+Runs go to `<out>.refine/` beside the output: the plan, and one journal line per finished run
+(its metrics, or its error), appended as each run ends. A refinement interrupted and started
+again runs only what the journal lacks; a failed run is kept with its reason."""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+from ..campaign.runner import sample_seed, simulate
+from ..quantity_table import per_fraction_metric
+from .store_data import DISCHARGE_METRICS
+from .local_correction import CorrectedNet
+from .quantities import Observation, test_conditions
+
+POSTERIOR_DRAWS = 6  # posterior draws among the target points
+PLAN_SEED = 2101
+
+
+@dataclasses.dataclass
+class Target:
+    """A parameter point the diagnosis predicts at, and why."""
+    why: str
+    point: dict  # every parameter of the box: base parameters and the candidates' values
+
+
+def target_points(d, candidates, ranges) -> list[Target]:
+    """The base estimate, posterior draws, and per covered candidate its refit and its detection limit."""
+    base_names = list(d.base.names)
+
+    def full(theta: dict, extra: dict | None = None) -> dict:
+        p = dict(theta)
+        for c in candidates:
+            if c.parameter in ranges:
+                p[c.parameter] = float(np.clip(c.neutral_value(theta), *ranges[c.parameter]))
+        p.update(extra or {})
+        return p
+
+    est = d.base.as_dict()
+    out = [Target("the base model's estimate", full(est))]
+    draws = d.base.posterior.get("draws")
+    if draws is not None and len(draws):
+        for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int):
+            out.append(Target(f"a draw from the base posterior ({k})", full(dict(zip(base_names, map(float, draws[k]))))))
+    for c in d.candidates:
+        if c.fit is not None:
+            theta = dict(zip(base_names, map(float, c.fit.best[:len(base_names)])))
+            out.append(Target(f"{c.effect} at its refit's estimate", full(theta, {c.parameter: float(c.estimate)})))
+        lim = d.detectable.get(c.effect, {})
+        for side in ("above", "below"):
+            if lim.get(side) is not None:
+                out.append(Target(f"{c.effect} at its detection limit ({side})", full(est, {c.parameter: float(lim[side])})))
+    return out
+
+
+def condition_groups(obs: list[Observation]) -> list[tuple[str, dict, list[float]]]:
+    """(rig, the run's conditions, the shear fractions measured) per rig test of the file."""
+    groups: dict = {}
+    for o in obs:
+        key = (o.quantity.rig, test_conditions(o))
+        groups.setdefault(key, set())
+        if "shear_fraction" in o.conditions:
+            groups[key].add(o.conditions["shear_fraction"])
+    return [(rig, dict(cond), sorted(fr)) for (rig, cond), fr in groups.items()]
+
+
+def _net_inputs(net, point: dict, conditions: dict) -> np.ndarray:
+    return np.array([conditions[n] if n in conditions else point[n] for n in net.input_names], float)
+
+
+def run_rows(nets: dict, rig: str, point: dict, conditions: dict, fractions: list[float]) -> list:
+    """[(quantity, inputs, metric name)] that one run of `rig` measures: each of the rig's nets at
+    the run's conditions (and each shear fraction)."""
+    out = []
+    for q, net in nets.items():
+        if q.rig != rig:
+            continue
+        if "shear_fraction" in net.input_names:
+            for f in fractions:
+                out.append((q, _net_inputs(net, point, conditions | {"shear_fraction": f}), per_fraction_metric(f)))
+        else:
+            out.append((q, _net_inputs(net, point, conditions), q.metric))
+    return out
+
+
+def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int) -> list[dict]:
+    """The refinement's runs, chosen greedily (module text): [{rig, point, conditions, fractions, why}]."""
+    targets = target_points(d, candidates, ranges)
+    groups = condition_groups(obs)
+    sigma = {i: float(s) for i, s in enumerate(d.base_model.sigma)}
+    # the target predictions: (quantity, inputs, weight 1 / sigma_row^2)
+    tq: dict = {}
+    for t in targets:
+        for i, o in enumerate(obs):
+            net = nets[o.quantity]
+            tq.setdefault(o.quantity, []).append((_net_inputs(net, t.point, o.conditions), 1.0 / sigma[i] ** 2))
+    options = [(t, g) for t in targets for g in groups]
+    option_rows = [run_rows(nets, g[0], t.point, g[1], g[2]) for t, g in options]
+    chosen: dict = {q: [] for q in tq}  # per quantity: the inputs of the runs picked so far
+
+    def left(q, xs) -> float:
+        """Weighted net-error variance left at q's targets after runs at xs."""
+        net = nets[q]
+        e2 = float(net.net_error) ** 2
+        x_t = np.array([x for x, _ in tq[q]])
+        w = np.array([w for _, w in tq[q]])
+        if not xs:
+            return float(np.sum(w) * e2)
+        x_s = np.array(xs)
+        corr = lambda a, b: np.exp(-0.5 * np.sum((net.scaled(a)[:, None] - net.scaled(b)[None]) ** 2, -1))  # noqa: E731
+        noise = (net.errors_at(x_s)[0] if hasattr(net, "errors_at") else np.full(len(x_s), net.seed_sd)) ** 2
+        k = e2 * corr(x_s, x_s) + np.diag(noise)
+        kt = e2 * corr(x_t, x_s)
+        v = e2 - np.sum(kt * np.linalg.solve(k, kt.T).T, axis=1)
+        return float(np.sum(w * np.clip(v, 0.0, None)))
+
+    now = {q: left(q, []) for q in tq}
+    picked = []
+    for _ in range(budget):
+        best, gain, best_left = None, 0.0, None
+        for j, rows in enumerate(option_rows):
+            new = dict(now)
+            for q in {q for q, _, _ in rows if q in tq}:
+                new[q] = left(q, chosen[q] + [x for qq, x, _ in rows if qq == q])
+            g = sum(now.values()) - sum(new.values())
+            if g > gain:
+                best, gain, best_left = j, g, new
+        if best is None:
+            break
+        t, (rig, cond, fractions) = options[best]
+        for q, x, _ in option_rows[best]:
+            if q in chosen:
+                chosen[q].append(x)
+        now = best_left
+        picked.append({"rig": rig, "point": t.point, "conditions": cond, "fractions": fractions, "why": t.why,
+                       "gain": gain})
+    return picked
+
+
+def plan_key(obs: list[Observation], budget: int, stores: dict) -> str:
+    """What a plan was made for: the rows, the budget and the stores (a resumed refinement must match)."""
+    text = json.dumps([[o.label, o.value, o.uncertainty] for o in obs] + [budget] +
+                      sorted(str(s.path) for s in stores.values()), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=print) -> list[dict]:
+    """Runs what the journal (folder/runs.jsonl) lacks, in local worker processes; returns every
+    journal entry (finished or failed, with the reason) in plan order."""
+    journal = folder / "runs.jsonl"
+    done = {}
+    if journal.exists():
+        for line in journal.read_text().splitlines():
+            if line.strip():
+                r = json.loads(line)
+                done[r["index"]] = r
+    todo = [i for i in range(len(runs)) if i not in done]
+    if todo:
+        say(f"  refinement: {len(runs) - len(todo)} of {len(runs)} runs in {journal}, running {len(todo)} "
+            f"({workers} worker{'s' if workers > 1 else ''})")
+    t0, finished, failed = time.perf_counter(), 0, 0
+    with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+        futures = {}
+        for i in todo:
+            r = runs[i]
+            spec = stores[r["rig"]].spec
+            fixed = dict(spec.fixed, num_threads=1)
+            if r["fractions"]:
+                fixed["shear_points"] = list(r["fractions"])
+            spec_json = dataclasses.replace(spec, fixed=fixed).to_json()
+            values = {k: v for k, v in (r["point"] | r["conditions"]).items() if k in spec.ranges}
+            futures[pool.submit(simulate, spec_json, values, sample_seed(PLAN_SEED, i))] = i
+        for fut in as_completed(futures):
+            i = futures[fut]
+            res = fut.result()
+            entry = {"index": i, **runs[i], "seed": sample_seed(PLAN_SEED, i), "wall": res.get("wall")}
+            if "error" in res:
+                entry["error"] = res["error"]
+                failed += 1
+            else:
+                entry["metrics"] = {k: v[0] for k, v in res["metrics"].items()}
+            finished += 1
+            with journal.open("a") as f:
+                f.write(json.dumps(entry) + "\n")
+            done[i] = entry
+            rate = (time.perf_counter() - t0) / finished
+            say(f"  refinement: {len(done)}/{len(runs)} runs, {failed} failed, ~{rate * (len(todo) - finished):.0f} s left"
+                + (f" (run {i}: {entry['error']})" if "error" in entry else ""))
+    return [done[i] for i in range(len(runs))]
+
+
+def corrected_nets(nets: dict, entries: list[dict]) -> dict:
+    """Each net with a correction from the runs that measured its quantity (nets no run measured:
+    as they were)."""
+    data: dict = {}
+    for e in entries:
+        if "metrics" not in e:
+            continue
+        m = e["metrics"]
+        jammed = e["rig"] == "hopper" and not math.isfinite(m.get("discharge_time", math.nan))
+        for q, x, metric in run_rows(nets, e["rig"], e["point"], e["conditions"], e["fractions"]):
+            v = m.get(metric)
+            if v is None or not math.isfinite(v) or (jammed and q.metric in DISCHARGE_METRICS):
+                continue
+            data.setdefault(q, ([], []))
+            data[q][0].append(x)
+            data[q][1].append(v)
+    return {q: (CorrectedNet(net, np.array(data[q][0]), np.array(data[q][1])) if q in data else net)
+            for q, net in nets.items()}
+
+
+def saved_plan(folder: Path, obs, budget: int, stores: dict) -> list[dict] | None:
+    """The plan in folder/plan.json when it was made for these rows, budget and stores; None when
+    there is none; ValueError when the folder holds another refinement (never mixed). Checked
+    before any work."""
+    f = folder / "plan.json"
+    if not f.exists():
+        return None
+    saved = json.loads(f.read_text())
+    if saved.get("key") != plan_key(obs, budget, stores):
+        raise ValueError(f"{folder} holds a refinement made for other rows, budget or stores; remove it or "
+                         f"choose another --out")
+    return saved["runs"]
+
+
+def save_plan(folder: Path, runs: list[dict], obs, budget: int, stores: dict):
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "plan.json").write_text(json.dumps({"key": plan_key(obs, budget, stores), "runs": runs}, indent=1))
+
+
+def summary(first, second, entries: list[dict], nets: dict, obs: list[Observation]) -> dict:
+    """What the report shows of a refinement: runs used and failed, their CPU time, each quantity's
+    error at the runs before (the global net) and after (leave one out), and per row the
+    measurement's uncertainty beside the net's error at the first and the second pass's estimate."""
+    per_q = {}
+    for q, net in nets.items():
+        if isinstance(net, CorrectedNet):
+            per_q[q.key] = {"runs": len(net.y), "net_rmse": net.raw_rmse(), "corrected_loo_rmse": net.loo_rmse()}
+    rows = [{"label": o.label, "uncertainty": o.uncertainty if o.uncertainty_given else None,
+             "net_error_first": float(a), "net_error_second": float(b)}
+            for o, a, b in zip(obs, first.base_model.net_errors, second.base_model.net_errors)]
+    return {"runs": len(entries), "failed": [{"index": e["index"], "rig": e["rig"], "error": e["error"]}
+                                             for e in entries if "error" in e],
+            "cpu_seconds": float(sum(e.get("wall") or 0.0 for e in entries)),
+            "quantities": per_q, "rows": rows,
+            "first_pass": {"verdict": first.verdict, "effects": first.effects, "estimate": first.base.as_dict(),
+                           "chi2_per_dof": first.base.chi2_per_dof},
+            "second_pass": {"verdict": second.verdict, "effects": second.effects, "estimate": second.base.as_dict(),
+                            "chi2_per_dof": second.base.chi2_per_dof}}

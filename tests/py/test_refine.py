@@ -1,0 +1,71 @@
+"""Refinement runs for one material (`pydem diagnose --refine N`, calibration/refine.py) on the
+tiny stores: the plan is made before any run and kept, the runs go to a journal beside the output,
+an interrupted refinement runs only what the journal lacks, another budget is refused rather than
+mixed, and the report shows both passes and each row's surrogate error against its uncertainty."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+STORES = [str(ROOT / "data/campaigns/diag_aor_tiny.h5"), str(ROOT / "data/campaigns/diag_hopper_tiny.h5")]
+
+
+def material_file(path: Path):
+    """Angle-of-repose and hopper rows (the two quick rigs) made by the tiny nets with lab noise."""
+    from pydem.calibration import synthetic
+    from pydem.calibration.setup import load_setup
+    setup = load_setup(STORES, say=lambda *a: None)
+    truth = synthetic.Truth({"friction": 0.5, "rolling_friction": 0.2, "restitution": 0.5}, None, None, None)
+    obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, np.random.default_rng(3),
+                                               synthetic.programme(setup.nets))
+    synthetic.to_csv(path, "m", obs, truth, "test_refine")
+
+
+def diagnose(tmp_path, *extra):
+    return subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(tmp_path / "m.csv"), "--material", "m",
+                           "--stores", *STORES, "--out", str(tmp_path / "out"), "--workers", "2", *extra],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600)
+
+
+@pytest.mark.slow
+def test_refinement_runs_resume_and_report_both_passes(tmp_path):
+    material_file(tmp_path / "m.csv")
+    r = diagnose(tmp_path, "--refine", "4")
+    assert r.returncode == 0, r.stderr + r.stdout
+    folder = tmp_path / "out.refine"
+    plan = json.loads((folder / "plan.json").read_text())["runs"]
+    journal = [json.loads(x) for x in (folder / "runs.jsonl").read_text().splitlines()]
+    assert len(plan) == 4 and sorted(e["index"] for e in journal) == [0, 1, 2, 3]
+    assert all("metrics" in e or "error" in e for e in journal)
+    gains = [p["gain"] for p in plan]
+    assert all(g > 0 for g in gains) and gains == sorted(gains, reverse=True)  # greedy: each run gains less
+    report = (tmp_path / "out/report.md").read_text()
+    assert "## Refinement: first and second pass" in report and "surrogate error, first pass" in report
+    data = json.loads((tmp_path / "out/diagnosis.json").read_text())["context"]["refinement"]
+    assert data["runs"] == 4 and len(data["rows"]) == 11
+    # interrupted after two runs: the rerun runs the other two only, with the same plan
+    (folder / "runs.jsonl").write_text("".join(json.dumps(e) + "\n" for e in journal[:2]))
+    r = diagnose(tmp_path, "--refine", "4")
+    assert r.returncode == 0, r.stderr
+    assert "2 of 4 runs in" in r.stdout and "running 2" in r.stdout
+    assert json.loads((folder / "plan.json").read_text())["runs"] == plan
+    again = [json.loads(x) for x in (folder / "runs.jsonl").read_text().splitlines()]
+    assert sorted(e["index"] for e in again) == [0, 1, 2, 3]
+    # another budget is not mixed into this refinement: refused before any work
+    r = diagnose(tmp_path, "--refine", "5")
+    assert r.returncode == 2 and "holds a refinement made for other rows, budget or stores" in r.stderr
+    assert "base model" not in r.stdout
+
+
+def test_refine_budget_is_checked_before_any_work(tmp_path):
+    material_file(tmp_path / "m.csv")
+    r = diagnose(tmp_path, "--refine", "-3")
+    assert r.returncode == 2 and "--refine takes 1..4096 runs" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(tmp_path / "m.csv"), "--material", "m",
+                        "--stores", *STORES, "--out", str(tmp_path / "out"), "--refine", "2", "--workers", "0"],
+                       capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert r.returncode == 2 and "--workers at least 1" in r.stderr
