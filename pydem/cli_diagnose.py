@@ -21,6 +21,7 @@ def add_parser(sub):
                         "the answer, the surrogates corrected by them, and the diagnosis again (runs kept, resumable, in "
                         "<out>.refine; docs/diagnosis.md §8)")
     p.add_argument("--workers", type=int, default=None, help="worker processes of the refinement runs (default: the cores)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run the refinement runs on a Dask cluster, e.g. tcp://host:8786")
     p.set_defaults(func=main)
 
 
@@ -65,7 +66,12 @@ def main(args) -> int:
             runs = refine.plan(d, obs, setup.nets, setup.candidates, setup.ranges, args.refine)
             refine.save_plan(refine_dir, runs, obs, args.refine, setup.stores)
         import os
-        entries = refine.run_plan(runs, setup.stores, refine_dir, args.workers or os.cpu_count() or 1, say)
+        try:
+            entries = refine.run_plan(runs, setup.stores, refine_dir, args.workers or os.cpu_count() or 1, say, args.dask)
+        except (ImportError, OSError, TimeoutError) as exc:
+            print(f"pydem diagnose: the refinement runs cannot start ({exc}); runs done so far are kept in {refine_dir}",
+                  file=sys.stderr)
+            return 2
         nets = refine.corrected_nets(setup.nets, entries)
         say(f"second pass, on the surrogates corrected by {sum('metrics' in e for e in entries)} runs:")
         first, d = d, diagnose(args.material, obs, nets, setup.ranges, setup.candidates, say)

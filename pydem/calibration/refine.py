@@ -5,8 +5,8 @@ diagnosis run again.
 
 Where the runs go. What decides a diagnosis is the rows' σ, and near a material the net's error
 is most of it. The refinement therefore runs the rigs at the points whose predictions the verdict
-uses — the base model's estimate and draws from its posterior, each covered candidate at its
-refit's estimate and at its detection limit — at the measured conditions, and picks the runs one
+uses — the base model's estimate and draws from its posterior (and the final model's, when an
+effect is named), each covered candidate at its refit's estimate and at its detection limit — at the measured conditions, and picks the runs one
 at a time, greedily, by how much each lowers the net-error variance summed over those target
 predictions, each weighted by 1 / σ_row² (its weight in χ²). The net-error variance left after a
 set of runs is the local correction's posterior variance, which does not depend on the runs'
@@ -17,7 +17,8 @@ runs where no row is predicted.
 
 Runs go to `<out>.refine/` beside the output: the plan, and one journal line per finished run
 (its metrics, or its error), appended as each run ends. A refinement interrupted and started
-again runs only what the journal lacks; a failed run is kept with its reason."""
+again runs only what the journal lacks; a failed run is kept with its reason. Local workers or a
+Dask cluster (`--dask ADDRESS`), as campaigns run."""
 from __future__ import annotations
 
 import dataclasses
@@ -25,12 +26,12 @@ import hashlib
 import json
 import math
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
 
 from ..campaign.runner import sample_seed, simulate
+from ..campaign.workers import run_local
 from ..quantity_table import per_fraction_metric
 from .store_data import DISCHARGE_METRICS
 from .local_correction import CorrectedNet
@@ -48,7 +49,8 @@ class Target:
 
 
 def target_points(d, candidates, ranges) -> list[Target]:
-    """The base estimate, posterior draws, and per covered candidate its refit and its detection limit."""
+    """The base estimate and posterior draws, the final model's when an effect was named, and per
+    covered candidate its refit and its detection limit."""
     base_names = list(d.base.names)
 
     def full(theta: dict, extra: dict | None = None) -> dict:
@@ -65,6 +67,16 @@ def target_points(d, candidates, ranges) -> list[Target]:
     if draws is not None and len(draws):
         for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int):
             out.append(Target(f"a draw from the base posterior ({k})", full(dict(zip(base_names, map(float, draws[k]))))))
+    if d.after is not None:  # an effect named: the final model's estimate and posterior decide its numbers
+        final = d.after.as_dict()
+        theta = {n: final[n] for n in base_names}
+        out.append(Target("the final model's estimate", full(theta, {n: v for n, v in final.items() if n not in theta})))
+        draws = d.after.posterior.get("draws")
+        if draws is not None and len(draws):
+            for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int):
+                p = dict(zip(d.after.names, map(float, draws[k])))
+                out.append(Target(f"a draw from the final posterior ({k})",
+                                  full({n: p[n] for n in base_names}, {n: v for n, v in p.items() if n not in base_names})))
     for c in d.candidates:
         if c.fit is not None:
             theta = dict(zip(base_names, map(float, c.fit.best[:len(base_names)])))
@@ -163,13 +175,15 @@ def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int)
 def plan_key(obs: list[Observation], budget: int, stores: dict) -> str:
     """What a plan was made for: the rows, the budget and the stores (a resumed refinement must match)."""
     text = json.dumps([[o.label, o.value, o.uncertainty] for o in obs] + [budget] +
-                      sorted(str(s.path) for s in stores.values()), sort_keys=True)
+                      sorted(s.path.name for s in stores.values()), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=print) -> list[dict]:
-    """Runs what the journal (folder/runs.jsonl) lacks, in local worker processes; returns every
-    journal entry (finished or failed, with the reason) in plan order."""
+def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=print, dask: str | None = None) -> list[dict]:
+    """Runs what the journal (folder/runs.jsonl) lacks — in local worker processes (the campaigns'
+    pool: a killed worker is retried once, Ctrl-C lets the running ones finish) or on a Dask
+    cluster — appending each run to the journal as it ends; returns every journal entry (finished
+    or failed, with the reason) in plan order."""
     journal = folder / "runs.jsonl"
     done = {}
     if journal.exists():
@@ -178,37 +192,49 @@ def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=pri
                 r = json.loads(line)
                 done[r["index"]] = r
     todo = [i for i in range(len(runs)) if i not in done]
-    if todo:
-        say(f"  refinement: {len(runs) - len(todo)} of {len(runs)} runs in {journal}, running {len(todo)} "
-            f"({workers} worker{'s' if workers > 1 else ''})")
+    if not todo:
+        return [done[i] for i in range(len(runs))]
+    where = f"on the Dask cluster {dask}" if dask else f"{workers} worker{'s' if workers > 1 else ''}"
+    say(f"  refinement: {len(runs) - len(todo)} of {len(runs)} runs in {journal}, running {len(todo)} ({where})")
+    jobs = {}
+    for i in todo:
+        r = runs[i]
+        spec = stores[r["rig"]].spec
+        fixed = dict(spec.fixed, num_threads=1)
+        if r["fractions"]:
+            fixed["shear_points"] = list(r["fractions"])
+        values = {k: v for k, v in (r["point"] | r["conditions"]).items() if k in spec.ranges}
+        jobs[i] = (dataclasses.replace(spec, fixed=fixed).to_json(), values, sample_seed(PLAN_SEED, i))
     t0, finished, failed = time.perf_counter(), 0, 0
-    with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
-        futures = {}
-        for i in todo:
-            r = runs[i]
-            spec = stores[r["rig"]].spec
-            fixed = dict(spec.fixed, num_threads=1)
-            if r["fractions"]:
-                fixed["shear_points"] = list(r["fractions"])
-            spec_json = dataclasses.replace(spec, fixed=fixed).to_json()
-            values = {k: v for k, v in (r["point"] | r["conditions"]).items() if k in spec.ranges}
-            futures[pool.submit(simulate, spec_json, values, sample_seed(PLAN_SEED, i))] = i
-        for fut in as_completed(futures):
-            i = futures[fut]
-            res = fut.result()
-            entry = {"index": i, **runs[i], "seed": sample_seed(PLAN_SEED, i), "wall": res.get("wall")}
-            if "error" in res:
-                entry["error"] = res["error"]
-                failed += 1
-            else:
-                entry["metrics"] = {k: v[0] for k, v in res["metrics"].items()}
-            finished += 1
-            with journal.open("a") as f:
-                f.write(json.dumps(entry) + "\n")
-            done[i] = entry
-            rate = (time.perf_counter() - t0) / finished
-            say(f"  refinement: {len(done)}/{len(runs)} runs, {failed} failed, ~{rate * (len(todo) - finished):.0f} s left"
-                + (f" (run {i}: {entry['error']})" if "error" in entry else ""))
+
+    def on_result(i: int, res: dict):
+        nonlocal finished, failed
+        entry = {"index": i, **runs[i], "seed": jobs[i][2], "wall": res.get("wall")}
+        if "error" in res:
+            entry["error"] = res["error"]
+            failed += 1
+        else:
+            entry["metrics"] = {k: v[0] for k, v in res["metrics"].items()}
+        finished += 1
+        with journal.open("a") as f:
+            f.write(json.dumps(entry) + "\n")
+        done[i] = entry
+        rate = (time.perf_counter() - t0) / finished
+        say(f"  refinement: {len(done)}/{len(runs)} runs, {failed} failed, ~{rate * (len(todo) - finished):.0f} s left"
+            + (f" (run {i}: {entry['error']})" if "error" in entry else ""))
+
+    if dask:
+        from distributed import Client, as_completed
+        with Client(dask, timeout="30s") as client:
+            futures = {client.submit(simulate, *a, pure=False, key=f"pydem-refine-{i}-{a[2]}"): i for i, a in jobs.items()}
+            index = {f.key: i for f, i in futures.items()}
+            for fut in as_completed(list(futures)):
+                on_result(index[fut.key], fut.result())
+    else:
+        run_local(jobs, simulate, max(1, min(workers, len(jobs))), on_result, say)
+    missing = [i for i in range(len(runs)) if i not in done]
+    if missing:  # interrupted (Ctrl-C): what ran is in the journal; the rest runs when started again
+        raise KeyboardInterrupt(f"refinement interrupted: {len(missing)} runs left, kept in {journal}")
     return [done[i] for i in range(len(runs))]
 
 

@@ -115,18 +115,19 @@ def test_posterior_matches_the_laplace_closed_form():
 
 @pytest.mark.slow
 def test_verdicts_accuracy_and_false_alarms_in_a_linear_world():
-    """Seeded sets: 100 null sets give false alarms at about the nominal level (two candidates at
-    p < 0.01: ~2 %; at most 5 allowed); sets with a clear hidden effect name it, and adding it
+    """Seeded sets: 60 null sets give false alarms at about the nominal level (two candidates at
+    p < 0.01: ~2 %, 1.2 expected; at most 4 allowed: P(more | 2 %) = 0.7 %, while a rate of 10 %
+    would exceed it 73 % of the time); sets with a clear hidden effect name it, and adding it
     brings chi^2/dof near 1."""
     nets, obs = world()
     rng = np.random.default_rng(5)
     false_alarms = 0
-    for k in range(100):
+    for k in range(60):
         theta = rng.uniform(0.2, 0.8, 3)
         d = dg.diagnose("null", generate(nets, obs, theta, {}, rng), nets, RANGES, CANDS, say=lambda *a: None,
                         detection_limits=False)  # the verdict only: a null's detection limits are not scored here
         false_alarms += d.verdict in ALARMS
-    assert false_alarms <= 5, false_alarms
+    assert false_alarms <= 4, false_alarms
     for name, eta in (("a", {"eta_a": 0.25}), ("b", {"eta_b": -0.3}), ("b", {"eta_b": 0.3})):
         d = dg.diagnose(name, generate(nets, obs, (0.4, 0.5, 0.5), eta, rng), nets, RANGES, CANDS, say=lambda *a: None)
         assert d.verdict == "effect" and d.effect == name, (d.verdict, d.effect)

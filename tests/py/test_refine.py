@@ -69,3 +69,20 @@ def test_refine_budget_is_checked_before_any_work(tmp_path):
                         "--stores", *STORES, "--out", str(tmp_path / "out"), "--refine", "2", "--workers", "0"],
                        capture_output=True, text=True, cwd=tmp_path, timeout=600)
     assert r.returncode == 2 and "--workers at least 1" in r.stderr
+
+
+def test_refinement_runs_on_a_dask_cluster_into_the_same_journal(tmp_path):
+    """The plan's runs through a Dask LocalCluster (two tiny hopper runs): the journal gets one line
+    per run with its metrics, as the local workers write it."""
+    import distributed
+    from pydem.calibration.refine import run_plan
+    from pydem.calibration.setup import open_stores
+    stores = open_stores(STORES)
+    point = {"friction": 0.5, "rolling_friction": 0.2, "restitution": 0.5, "wall_friction": 0.5, "size_spread": 0.1,
+             "effects.cohesion_sjkr.cohesion_energy_density": 0.0}
+    runs = [{"rig": "hopper", "point": point, "conditions": {"slot_width": b}, "fractions": [], "why": "test", "gain": 1.0}
+            for b in (0.03, 0.04)]
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        entries = run_plan(runs, stores, tmp_path, 1, say=lambda *a: None, dask=cluster.scheduler_address)
+    assert [e["index"] for e in entries] == [0, 1] and all(e["metrics"]["mass_flow_rate"] > 0 for e in entries)
+    assert len((tmp_path / "runs.jsonl").read_text().splitlines()) == 2
