@@ -217,7 +217,7 @@ class Scaling:
             out.append(f"mean particle diameter {d * 1e3:.4g} mm{where}: the model's spheres are the stores' "
                        f"coarse-grained ones ({sizes}); angles, friction coefficients and solid fractions compared as "
                        f"they are" + (", hopper slots at the same slot width over size and flow rates by Beverloo's "
-                                      f"law" if self.size_ratio("hopper") != 1.0 else ""))
+                                      "law" if self.size_ratio("hopper") != 1.0 else ""))
         spread = m.spread
         if spread is not None and ranges is not None and SPREAD_PARAMETER in ranges:
             lo, hi = ranges[SPREAD_PARAMETER]
