@@ -17,6 +17,13 @@ top-1, error fall and coverage (the truth inside the final model's 95 % interval
         --label new --out studies/results/independent_sets.new.json [--checkout DIR] [--no-origin]
     .venv/bin/python studies/independent_sets.py summary studies/results/independent_sets.*.json
 
+With `--refine N --runs DIR` the diagnose step refines each set (`pydem diagnose --refine N`, the
+runs kept in DIR/set<k>.refine, so an interrupted validation resumes run by run) and keeps both
+passes; `summary` then scores the first pass too (the refinement's validation, docs/diagnosis.md §8):
+
+    .venv/bin/python studies/independent_sets.py diagnose --journals studies/results/independent_sets_*.jsonl \
+        --label refined64 --out studies/results/independent_sets.refined64.json --refine 64 --runs build/refine_runs
+
 The programme: ring shear at pre-shear 1, 2 and 5 kPa with shear points at 45 and 70 % (the
 stores shear at 30, 60 and 90 %), the angle of repose with its poured bulk density, the hopper at
 slot widths 36, 47, 59 and 70 mm. Seeds 7000 + set: no store ran them."""
@@ -160,10 +167,11 @@ def diagnose(args):
                 continue
             meas = Path(tmp) / f"set{row['set']}.csv"
             measurement_file(meas, row, not args.no_origin)
-            res = Path(tmp) / f"set{row['set']}"
+            res = (Path(args.runs) if args.refine else Path(tmp)) / f"set{row['set']}"
+            refine = ["--refine", str(args.refine), "--workers", str(args.workers)] if args.refine else []
             t0 = time.perf_counter()
             run_ = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", f"set{row['set']}",
-                                   "--out", str(res)], cwd=checkout, capture_output=True, text=True,
+                                   "--out", str(res), *refine], cwd=checkout, capture_output=True, text=True,
                                   env={**__import__("os").environ, "PYTHONPATH": str(checkout)})
             if run_.returncode != 0:
                 out["sets"].append({"set": row["set"], "kind": row["kind"], "error": run_.stderr[-500:]})
@@ -182,6 +190,12 @@ def diagnose(args):
                                 "rmse_after": d["after"]["rmse_relative"] if d.get("after") else None,
                                 "chi2_before": d["before"]["chi2_per_dof"], "covered": cover,
                                 "seconds": time.perf_counter() - t0})
+            ref = d["context"].get("refinement")
+            if ref:  # the first pass, scored as the sets were before refinement
+                first = ref["first_pass"]
+                out["sets"][-1]["first_pass"] = {"verdict": first["verdict"], "effects": first["effects"]}
+                out["sets"][-1]["refinement"] = {"runs": ref["runs"], "failed": len(ref["failed"]),
+                                                 "cpu_seconds": ref["cpu_seconds"], "quantities": ref["quantities"]}
             s = out["sets"][-1]
             print(f"set {row['set']:2d} {row['kind']:28s} -> {s['verdict']:18s} {'+'.join(effects) or '-':28s} "
                   f"covered {sum(cover.values())}/{len(cover)}", flush=True)
@@ -209,6 +223,15 @@ def summary(args):
               f"{top1}/{len(single)}; two-effect sets with both {both}/{len(double)}; error after/before median "
               f"{np.median(ratio) if ratio else float('nan'):.2f}; coverage {sum(cov)}/{len(cov)} "
               f"({100 * sum(cov) / max(len(cov), 1):.0f} %); failed runs {len(r['sets']) - len(sets)}")
+        first = [s for s in sets if "first_pass" in s]
+        if first:
+            fa1 = sum(bool(s["first_pass"]["effects"]) or s["first_pass"]["verdict"] in ALARMS for s in first
+                      if s["kind"] == "null")
+            top1_1 = sum(s["first_pass"]["effects"][:1] == [s["kind"]] for s in first if s["kind"] != "null" and "+" not in s["kind"])
+            runs = [s["refinement"]["runs"] for s in first]
+            cpu = [s["refinement"]["cpu_seconds"] / 3600 for s in first]
+            print(f"  first pass of the same sets: false alarms {fa1}, single effects named {top1_1}; refinement runs "
+                  f"per set {np.median(runs):.0f} (median), CPU {np.median(cpu):.2f} h per set (median)")
 
 
 def main() -> int:
@@ -223,6 +246,9 @@ def main() -> int:
     dg.add_argument("--out", required=True)
     dg.add_argument("--checkout", default=str(ROOT), help="the pydem to score (default: this one)")
     dg.add_argument("--no-origin", action="store_true", help="files without the origin column (older readers)")
+    dg.add_argument("--refine", type=int, default=0, help="refinement runs per set (pydem diagnose --refine)")
+    dg.add_argument("--runs", default="build/refine_runs", help="where each set's output and refinement runs are kept")
+    dg.add_argument("--workers", type=int, default=2, help="worker processes of each set's refinement runs")
     sm = sub.add_parser("summary")
     sm.add_argument("results", nargs="+")
     args = ap.parse_args()
