@@ -92,7 +92,7 @@ def main() -> int:
         keep = sorted(values)
         noisy = synthetic.with_lab_noise([obs[i] for i in keep], {k: values[i] for k, i in enumerate(keep)}, setup.nets,
                                          np.random.default_rng(a.seed))
-        path = Path(a.out).with_name(f"material_sets_{name.split()[0].strip(chr(39))}.csv")
+        path = Path(a.out).resolve().with_name(f"material_sets_{name.split()[0].strip(chr(39))}.csv")
         synthetic.to_csv(path, "m", noisy, truth, f"studies/material_sets.py: {name}", material_rows)
         rows = load_measurements(path, "m")
         scaling = setup.scaling(MaterialProperties.from_rows(rows))

@@ -96,7 +96,8 @@ def test_a_sieve_table_gives_the_mean_size_and_the_spread(tiny, tmp_path):
 def test_another_particle_size_scales_the_hopper_slot_and_flow_rate(tiny, tmp_path):
     """Coarse-graining: spheres twice the tiny hopper store's size in a slot of 2 b are the store's
     slot b (the same b/d), their flow rate the store's times 2^(3/2) (Beverloo, a slot of fixed
-    length); a discharge time is left out (it depends on the fill's mass); angles as they are."""
+    length); a discharge time is left out (it depends on the fill's mass), and so is a bulk density
+    (a cell a few spheres wide packs by the size); angles as they are."""
     ds = tiny.scaling(MaterialProperties()).store_diameters
     hopper_d = ds["hopper"]
     assert ds["aor"] == ds["ring-shear"] == 3e-3 and hopper_d == pytest.approx(0.3 * 4e-3 + 0.7 * 6e-3)
@@ -106,10 +107,13 @@ def test_another_particle_size_scales_the_hopper_slot_and_flow_rate(tiny, tmp_pa
     (tmp_path / "big.csv").write_text(HEADER + f"m,hopper,mass_flow_rate,{0.3 * 2 ** 1.5},{0.006 * 2 ** 1.5},,"
                                       f"slot_width={2 * b},calibrate,x\n" + "m,aor,angle_of_repose,31,0.5,,,calibrate,x\n"
                                       + f"m,hopper,discharge_time,2.0,0.05,,slot_width={2 * b},calibrate,x\n"
+                                      + f"m,hopper,bulk_density,1300,13,,slot_width={2 * b},calibrate,x\n"
                                       + f"m,material,particle_diameter,{2 * hopper_d * 1e3},,mm,,,x\n")
     ref, _ = observations_of(load(tmp_path / "ref.csv", "m"), tiny, "ref", "m")
     got, skipped = observations_of(load(tmp_path / "big.csv", "m"), tiny, "big", "m")
-    assert len(got) == 2 and len(skipped) == 1 and "line 4" in skipped[0] and "fill's mass" in skipped[0]
+    assert len(got) == 2 and len(skipped) == 2 and "line 4" in skipped[0] and "fill's mass" in skipped[0]
+    # a bulk density of spheres twice the store's: the cell's solid fraction depends on the size
+    assert "line 5" in skipped[1] and "packs to a solid fraction that depends on the size" in skipped[1]
     for a, c in zip(ref, got):
         assert c.value == pytest.approx(a.value, rel=1e-12) and c.conditions == pytest.approx(a.conditions, rel=1e-12)
     # the slot scaled past the store's declared range is left out as any condition is
