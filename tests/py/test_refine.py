@@ -47,6 +47,9 @@ def test_refinement_runs_resume_and_report_both_passes(tmp_path):
     assert "## Refinement: first and second pass" in report and "surrogate error, first pass" in report
     data = json.loads((tmp_path / "out/diagnosis.json").read_text())["context"]["refinement"]
     assert data["runs"] == 4 and len(data["rows"]) == 11
+    # its three tables fit a narrow window (headless Chromium at 500 px, the page's own scroll width)
+    from test_report_browser import page_width
+    assert page_width(tmp_path / "out/report.html", 500, tmp_path) <= 500
     # interrupted after two runs: the rerun runs the other two only, with the same plan
     (folder / "runs.jsonl").write_text("".join(json.dumps(e) + "\n" for e in journal[:2]))
     r = diagnose(tmp_path, "--refine", "4")
