@@ -22,6 +22,9 @@ def add_parser(sub):
                         "<out>.refine; docs/diagnosis.md §8)")
     p.add_argument("--workers", type=int, default=None, help="worker processes of the refinement runs (default: the cores)")
     p.add_argument("--dask", metavar="ADDRESS", help="run the refinement runs on a Dask cluster, e.g. tcp://host:8786")
+    p.add_argument("--refine-design", choices=("greedy", "fixed"), default="greedy",
+                   help="where the refinement runs go: greedy (the net error the verdict's predictions lose, the "
+                        "default) or fixed (a Sobol design over the posterior's box, the simple alternative)")
     p.set_defaults(func=main)
 
 
@@ -49,7 +52,7 @@ def main(args) -> int:
     if args.refine:
         from .calibration import refine
         try:
-            runs = refine.saved_plan(refine_dir, obs, args.refine, setup.stores)
+            runs = refine.saved_plan(refine_dir, obs, args.refine, setup.stores, args.refine_design)
         except (ValueError, OSError) as exc:
             print(f"pydem diagnose: {exc}", file=sys.stderr)
             return 2
@@ -63,8 +66,10 @@ def main(args) -> int:
     refinement = None
     if args.refine:
         if runs is None:
-            runs = refine.plan(d, obs, setup.nets, setup.candidates, setup.ranges, args.refine)
-            refine.save_plan(refine_dir, runs, obs, args.refine, setup.stores)
+            runs = (refine.plan(d, obs, setup.nets, setup.candidates, setup.ranges, args.refine)
+                    if args.refine_design == "greedy" else
+                    refine.plan_fixed(d, obs, setup.candidates, setup.ranges, args.refine))
+            refine.save_plan(refine_dir, runs, obs, args.refine, setup.stores, args.refine_design)
         import os
         try:
             entries = refine.run_plan(runs, setup.stores, refine_dir, args.workers or os.cpu_count() or 1, say, args.dask)

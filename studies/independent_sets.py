@@ -23,6 +23,7 @@ passes; `summary` then scores the first pass too (the refinement's validation, d
 
     .venv/bin/python studies/independent_sets.py diagnose --journals studies/results/independent_sets_*.jsonl \
         --label refined64 --out studies/results/independent_sets.refined64.json --refine 64 --runs build/refine_runs
+    (and --refine-design fixed --runs build/refine_runs_fixed for the simple alternative on the same budget)
 
 The programme: ring shear at pre-shear 1, 2 and 5 kPa with shear points at 45 and 70 % (the
 stores shear at 30, 60 and 90 %), the angle of repose with its poured bulk density, the hopper at
@@ -168,7 +169,8 @@ def diagnose(args):
             meas = Path(tmp) / f"set{row['set']}.csv"
             measurement_file(meas, row, not args.no_origin)
             res = (Path(args.runs) if args.refine else Path(tmp)) / f"set{row['set']}"
-            refine = ["--refine", str(args.refine), "--workers", str(args.workers)] if args.refine else []
+            refine = (["--refine", str(args.refine), "--workers", str(args.workers), "--refine-design", args.refine_design]
+                      if args.refine else [])
             t0 = time.perf_counter()
             run_ = subprocess.run([sys.executable, "-m", "pydem", "diagnose", str(meas), "--material", f"set{row['set']}",
                                    "--out", str(res), *refine], cwd=checkout, capture_output=True, text=True,
@@ -249,6 +251,7 @@ def main() -> int:
     dg.add_argument("--refine", type=int, default=0, help="refinement runs per set (pydem diagnose --refine)")
     dg.add_argument("--runs", default="build/refine_runs", help="where each set's output and refinement runs are kept")
     dg.add_argument("--workers", type=int, default=2, help="worker processes of each set's refinement runs")
+    dg.add_argument("--refine-design", default="greedy", choices=("greedy", "fixed"), help="pydem diagnose --refine-design")
     sm = sub.add_parser("summary")
     sm.add_argument("results", nargs="+")
     args = ap.parse_args()

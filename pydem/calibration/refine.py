@@ -172,10 +172,36 @@ def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int)
     return picked
 
 
-def plan_key(obs: list[Observation], budget: int, stores: dict) -> str:
+def plan_fixed(d, obs: list[Observation], candidates, ranges, budget: int, seed: int = PLAN_SEED) -> list[dict]:
+    """The simple alternative the greedy plan is compared with (docs/diagnosis.md §8): a scrambled
+    Sobol design over the final model's 95 % posterior box (its base parameters and named effects;
+    the other candidates neutral), the points dealt to the measured rig tests in turn."""
+    from scipy.stats import qmc
+    final = d.after if d.after is not None else d.base
+    post = final.posterior.get("parameters", {})
+    names = list(final.names)
+    lo = np.array([post[n]["lo"] if n in post else final.lo[j] for j, n in enumerate(names)])
+    hi = np.array([post[n]["hi"] if n in post else final.hi[j] for j, n in enumerate(names)])
+    pts = qmc.scale(qmc.Sobol(len(names), scramble=True, seed=seed).random(budget), lo, np.maximum(hi, lo + 1e-12))
+    groups = condition_groups(obs)
+    base_names = list(d.base.names)
+    out = []
+    for k, x in enumerate(pts):
+        p = dict(zip(names, map(float, x)))
+        theta = {n: p[n] for n in base_names}
+        point = {c.parameter: float(np.clip(c.neutral_value(theta), *ranges[c.parameter]))
+                 for c in candidates if c.parameter in ranges} | p
+        rig, cond, fractions = groups[k % len(groups)]
+        out.append({"rig": rig, "point": point, "conditions": cond, "fractions": fractions,
+                    "why": f"fixed design point {k}", "gain": None})
+    return out
+
+
+def plan_key(obs: list[Observation], budget: int, stores: dict, design: str = "greedy") -> str:
     """What a plan was made for: the rows, the budget and the stores (a resumed refinement must match)."""
     text = json.dumps([[o.label, o.value, o.uncertainty] for o in obs] + [budget] +
-                      sorted(s.path.name for s in stores.values()), sort_keys=True)
+                      sorted(s.path.name for s in stores.values()) + ([] if design == "greedy" else [design]),
+                      sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -258,7 +284,7 @@ def corrected_nets(nets: dict, entries: list[dict]) -> dict:
             for q, net in nets.items()}
 
 
-def saved_plan(folder: Path, obs, budget: int, stores: dict) -> list[dict] | None:
+def saved_plan(folder: Path, obs, budget: int, stores: dict, design: str = "greedy") -> list[dict] | None:
     """The plan in folder/plan.json when it was made for these rows, budget and stores; None when
     there is none; ValueError when the folder holds another refinement (never mixed). Checked
     before any work."""
@@ -266,15 +292,16 @@ def saved_plan(folder: Path, obs, budget: int, stores: dict) -> list[dict] | Non
     if not f.exists():
         return None
     saved = json.loads(f.read_text())
-    if saved.get("key") != plan_key(obs, budget, stores):
-        raise ValueError(f"{folder} holds a refinement made for other rows, budget or stores; remove it or "
+    if saved.get("key") != plan_key(obs, budget, stores, design):
+        raise ValueError(f"{folder} holds a refinement made for other rows, budget, stores or design; remove it or "
                          f"choose another --out")
     return saved["runs"]
 
 
-def save_plan(folder: Path, runs: list[dict], obs, budget: int, stores: dict):
+def save_plan(folder: Path, runs: list[dict], obs, budget: int, stores: dict, design: str = "greedy"):
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / "plan.json").write_text(json.dumps({"key": plan_key(obs, budget, stores), "runs": runs}, indent=1))
+    (folder / "plan.json").write_text(json.dumps({"key": plan_key(obs, budget, stores, design), "design": design,
+                                                  "runs": runs}, indent=1))
 
 
 def summary(first, second, entries: list[dict], nets: dict, obs: list[Observation]) -> dict:

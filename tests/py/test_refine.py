@@ -60,7 +60,7 @@ def test_refinement_runs_resume_and_report_both_passes(tmp_path):
     assert sorted(e["index"] for e in again) == [0, 1, 2, 3]
     # another budget is not mixed into this refinement: refused before any work
     r = diagnose(tmp_path, "--refine", "5")
-    assert r.returncode == 2 and "holds a refinement made for other rows, budget or stores" in r.stderr
+    assert r.returncode == 2 and "holds a refinement made for other rows, budget, stores or design" in r.stderr
     assert "base model" not in r.stdout
 
 
@@ -89,3 +89,25 @@ def test_refinement_runs_on_a_dask_cluster_into_the_same_journal(tmp_path):
         entries = run_plan(runs, stores, tmp_path, 1, say=lambda *a: None, dask=cluster.scheduler_address)
     assert [e["index"] for e in entries] == [0, 1] and all(e["metrics"]["mass_flow_rate"] > 0 for e in entries)
     assert len((tmp_path / "runs.jsonl").read_text().splitlines()) == 2
+
+
+def test_the_fixed_design_lies_in_the_posterior_box_and_deals_the_tests_in_turn(tmp_path):
+    """The alternative plan: Sobol points inside the final model's 95 % intervals, one rig test after
+    the other."""
+    from pydem.calibration import diagnose as dg
+    from pydem.calibration import synthetic
+    from pydem.calibration.refine import condition_groups, plan_fixed
+    from pydem.calibration.setup import load_setup
+    setup = load_setup(STORES, say=lambda *a: None)
+    truth = synthetic.Truth({"friction": 0.5, "rolling_friction": 0.2, "restitution": 0.5}, None, None, None)
+    obs, _ = synthetic.surrogate_set_and_means(setup.nets, setup.candidates, truth, np.random.default_rng(3),
+                                               synthetic.programme(setup.nets))
+    d = dg.diagnose("m", obs, setup.nets, setup.ranges, setup.candidates, say=lambda *a: None, detection_limits=False)
+    runs = plan_fixed(d, obs, setup.candidates, setup.ranges, 8)
+    post = d.base.posterior["parameters"]
+    groups = condition_groups(obs)
+    assert len(runs) == 8 and [r["rig"] for r in runs] == [groups[k % len(groups)][0] for k in range(8)]
+    for r in runs:
+        for n, p in post.items():
+            assert p["lo"] - 1e-9 <= r["point"][n] <= p["hi"] + 1e-9
+        assert r["point"]["wall_friction"] == pytest.approx(r["point"]["friction"])  # neutral: follows friction
