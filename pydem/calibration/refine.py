@@ -61,22 +61,20 @@ def target_points(d, candidates, ranges) -> list[Target]:
         p.update(extra or {})
         return p
 
-    est = d.base.as_dict()
-    out = [Target("the base model's estimate", full(est))]
-    draws = d.base.posterior.get("draws")
-    if draws is not None and len(draws):
-        for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int):
-            out.append(Target(f"a draw from the base posterior ({k})", full(dict(zip(base_names, map(float, draws[k]))))))
-    if d.after is not None:  # an effect named: the final model's estimate and posterior decide its numbers
-        final = d.after.as_dict()
-        theta = {n: final[n] for n in base_names}
-        out.append(Target("the final model's estimate", full(theta, {n: v for n, v in final.items() if n not in theta})))
-        draws = d.after.posterior.get("draws")
+    def model_points(fit, which: str) -> list[Target]:  # a fit's estimate and draws from its posterior
+        def split(p: dict) -> dict:
+            return full({n: p[n] for n in base_names}, {n: v for n, v in p.items() if n not in base_names})
+        pts = [Target(f"the {which} model's estimate", split(fit.as_dict()))]
+        draws = fit.posterior.get("draws")
         if draws is not None and len(draws):
-            for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int):
-                p = dict(zip(d.after.names, map(float, draws[k])))
-                out.append(Target(f"a draw from the final posterior ({k})",
-                                  full({n: p[n] for n in base_names}, {n: v for n, v in p.items() if n not in base_names})))
+            pts += [Target(f"a draw from the {which} posterior ({k})", split(dict(zip(fit.names, map(float, draws[k])))))
+                    for k in np.linspace(0, len(draws) - 1, POSTERIOR_DRAWS).astype(int)]
+        return pts
+
+    est = d.base.as_dict()
+    out = model_points(d.base, "base")
+    if d.after is not None:  # an effect named: the final model's estimate and posterior decide its numbers
+        out += model_points(d.after, "final")
     for c in d.candidates:
         if c.fit is not None:
             theta = dict(zip(base_names, map(float, c.fit.best[:len(base_names)])))
