@@ -309,7 +309,8 @@ def summary(first, second, entries: list[dict], nets: dict, obs: list[Observatio
     per_q = {}
     for q, net in nets.items():
         if isinstance(net, CorrectedNet):
-            per_q[q.key] = {"runs": len(net.y), "net_rmse": net.raw_rmse(), "corrected_loo_rmse": net.loo_rmse()}
+            per_q[q.key] = {"runs": len(net.y), "net_rmse": net.raw_rmse(), "corrected_loo_rmse": net.loo_rmse(),
+                            "seed_sd": float(np.sqrt(np.mean(net.noise)))}
     rows = [{"label": o.label, "uncertainty": o.uncertainty if o.uncertainty_given else None,
              "net_error_first": float(a), "net_error_second": float(b)}
             for o, a, b in zip(obs, first.base_model.net_errors, second.base_model.net_errors)]
@@ -317,7 +318,11 @@ def summary(first, second, entries: list[dict], nets: dict, obs: list[Observatio
                                              for e in entries if "error" in e],
             "cpu_seconds": float(sum(e.get("wall") or 0.0 for e in entries)),
             "quantities": per_q, "rows": rows,
-            "first_pass": {"verdict": first.verdict, "effects": first.effects, "estimate": first.base.as_dict(),
-                           "chi2_per_dof": first.base.chi2_per_dof},
-            "second_pass": {"verdict": second.verdict, "effects": second.effects, "estimate": second.base.as_dict(),
-                            "chi2_per_dof": second.base.chi2_per_dof}}
+            "first_pass": _pass(first), "second_pass": _pass(second)}
+
+
+def _pass(d) -> dict:
+    """One pass as the report compares it: verdict, base fit, and the final model's estimates."""
+    final = d.after if d.after is not None else d.base
+    return {"verdict": d.verdict, "effects": d.effects, "estimate": d.base.as_dict(),
+            "chi2_per_dof": d.base.chi2_per_dof, "final_estimate": final.as_dict()}

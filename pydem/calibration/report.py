@@ -350,16 +350,18 @@ def refinement_section(r: dict) -> tuple[str, str, str]:
     """The two passes side by side, the runs, and each row's surrogate error against its measurement's
     uncertainty before and after the refinement (refine.summary)."""
     a, b = r["first_pass"], r["second_pass"]
-    names = list(a["estimate"])
+    names = list(dict.fromkeys([*a.get("final_estimate", a["estimate"]), *b.get("final_estimate", b["estimate"])]))
     rows = [[name, _g(p["chi2_per_dof"], ".2f"), p["verdict"] + (f" ({' + '.join(p['effects'])})" if p["effects"] else ""),
-             *[_g(p["estimate"][n], ".3g") for n in names]] for name, p in (("first pass (shipped stores)", a),
-                                                                             ("second pass (refined)", b))]
-    md1, h1 = page.table(rows, ["pass", "base chi^2/dof", "verdict", *names])
+             *[_g(p.get("final_estimate", p["estimate"]).get(n), ".3g") if n in p.get("final_estimate", p["estimate"])
+               else "-" for n in names]] for name, p in (("first pass (shipped stores)", a), ("second pass (refined)", b))]
+    md1, h1 = page.table(rows, ["pass", "base chi^2/dof", "verdict", *[f"{n.split('.')[-1]} (final model)" for n in names]])
     rows = [[x["label"], _g(x["uncertainty"]) if x["uncertainty"] is not None else "not given",
              _g(x["net_error_first"]), _g(x["net_error_second"])] for x in r["rows"]]
     md2, h2 = page.table(rows, ["measurement", "its uncertainty", "surrogate error, first pass", "after refinement"])
-    rows = [[q, v["runs"], _g(v["net_rmse"]), _g(v["corrected_loo_rmse"])] for q, v in r["quantities"].items()]
-    md3, h3 = page.table(rows, ["quantity", "runs", "global net's RMSE at the runs", "corrected, leave one out"])
+    rows = [[q, v["runs"], _g(v["net_rmse"]), _g(v["corrected_loo_rmse"]), _g(v.get("seed_sd"))]
+            for q, v in r["quantities"].items()]
+    md3, h3 = page.table(rows, ["quantity", "runs", "global net's RMSE at the runs", "corrected, leave one out",
+                                "one run's seed scatter there (the floor of both)"])
     failed = "; ".join(f"run {f['index']} ({f['rig']}): {f['error']}" for f in r["failed"]) or "none"
     text = (f"{r['runs']} refinement runs ({r['cpu_seconds']:.0f} s of CPU; failed: {failed}), kept in {r['folder']}. "
             f"The second pass uses the surrogates corrected by them (docs/diagnosis.md §8); the rest of this report is "
