@@ -29,13 +29,16 @@ class CorrectedNet:
     """A QuantityNet plus the Gaussian-process correction learnt from runs (x: (n, inputs) in the
     net's input order, y: (n,)); every other attribute is the net's."""
 
-    def __init__(self, net, x: np.ndarray, y: np.ndarray):
+    def __init__(self, net, x: np.ndarray, y: np.ndarray, seed_scale: tuple[float, int] = (1.0, 0)):
+        """seed_scale: (factor, degrees of freedom) on the net's seed scatter from repeated runs
+        (refine.local_seed_scale); it scales the runs' noise here and the seed scatter of errors_at."""
         self.net = net
+        self.seed_scale = (float(seed_scale[0]), int(seed_scale[1]))
         self.x = np.atleast_2d(np.asarray(x, float))
         self.y = np.asarray(y, float)
         self.prior_sd = float(net.net_error)
         seed = net.errors_at(self.x)[0] if hasattr(net, "errors_at") else np.full(len(self.y), net.seed_sd)
-        self.noise = np.asarray(seed, float) ** 2
+        self.noise = (np.asarray(seed, float) * self.seed_scale[0]) ** 2
         self.residuals = self.y - net(self.x)
         k = self.prior_sd ** 2 * self._corr(self.x, self.x) + np.diag(self.noise)
         self._chol = linalg.cho_factor(k, lower=True)
@@ -80,7 +83,11 @@ class CorrectedNet:
         else:
             m = len(np.atleast_2d(x))
             seed, err = np.full(m, self.net.seed_sd), np.full(m, self.net.net_error)
-        return seed, err * np.sqrt(np.maximum(self.variance_fraction(x), FLOOR ** 2))
+        return seed * self.seed_scale[0], err * np.sqrt(np.maximum(self.variance_fraction(x), FLOOR ** 2))
+
+    @property
+    def seed_sd(self) -> float:
+        return float(self.net.seed_sd) * self.seed_scale[0]
 
     @property
     def net_error(self) -> float:

@@ -39,6 +39,10 @@ from .quantities import Observation, test_conditions
 
 POSTERIOR_DRAWS = 6  # posterior draws among the target points
 PLAN_SEED = 2101
+# runs kept for repeats of the plan's first run (its highest gain), other seeds: the seed scatter
+# where the material is, measured; one in eight of the budget, at least two (with a budget of 4+)
+REPLICATE_SHARE = 8
+PRIOR_DOF = 4  # the nets' seed scatter counts as this many degrees of freedom beside the repeats' own
 
 
 @dataclasses.dataclass
@@ -149,7 +153,8 @@ def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int)
 
     now = {q: left(q, []) for q in tq}
     picked = []
-    for _ in range(budget):
+    repeats = max(2, budget // REPLICATE_SHARE) if budget >= 4 else 0
+    for _ in range(budget - repeats):
         best, gain, best_left = None, 0.0, None
         for j, rows in enumerate(option_rows):
             new = dict(now)
@@ -167,6 +172,9 @@ def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int)
         now = best_left
         picked.append({"rig": rig, "point": t.point, "conditions": cond, "fractions": fractions, "why": t.why,
                        "gain": gain})
+    if picked:
+        picked += [dict(picked[0], why="a repeat of run 0 with another seed (the seed scatter there)", gain=None)
+                   for _ in range(repeats)]
     return picked
 
 
@@ -264,22 +272,49 @@ def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=pri
 
 def corrected_nets(nets: dict, entries: list[dict]) -> dict:
     """Each net with a correction from the runs that measured its quantity (nets no run measured:
-    as they were)."""
+    as they were), its seed scatter rescaled by what repeated runs measure (local_seed_scale)."""
     data: dict = {}
     for e in entries:
         if "metrics" not in e:
             continue
         m = e["metrics"]
         jammed = e["rig"] == "hopper" and not math.isfinite(m.get("discharge_time", math.nan))
+        where = json.dumps([e["rig"], e["point"], e["conditions"]], sort_keys=True)
         for q, x, metric in run_rows(nets, e["rig"], e["point"], e["conditions"], e["fractions"]):
             v = m.get(metric)
             if v is None or not math.isfinite(v) or (jammed and q.metric in DISCHARGE_METRICS):
                 continue
-            data.setdefault(q, ([], []))
-            data[q][0].append(x)
-            data[q][1].append(v)
-    return {q: (CorrectedNet(net, np.array(data[q][0]), np.array(data[q][1])) if q in data else net)
-            for q, net in nets.items()}
+            xs, ys, keys = data.setdefault(q, ([], [], []))
+            xs.append(x)
+            ys.append(v)
+            keys.append(where + metric)
+    out = {}
+    for q, net in nets.items():
+        if q in data:
+            x, y = np.array(data[q][0]), np.array(data[q][1])
+            out[q] = CorrectedNet(net, x, y, seed_scale=local_seed_scale(net, x, y, data[q][2]))
+        else:
+            out[q] = net
+    return out
+
+
+def local_seed_scale(net, x: np.ndarray, y: np.ndarray, keys: list[str]) -> tuple[float, int]:
+    """(factor on the net's seed scatter, the repeats' degrees of freedom): the pooled variance of
+    runs repeated at one point (same key), against the net's seed scatter at those runs, with the
+    net's own counted as PRIOR_DOF degrees of freedom; (1, 0) without repeats."""
+    groups: dict = {}
+    for i, k in enumerate(keys):
+        groups.setdefault(k, []).append(i)
+    repeated = [idx for idx in groups.values() if len(idx) > 1]
+    if not repeated:
+        return 1.0, 0
+    ss = sum(float(np.sum((y[idx] - y[idx].mean()) ** 2)) for idx in repeated)
+    dof = sum(len(idx) - 1 for idx in repeated)
+    at = x[[i for idx in repeated for i in idx]]
+    prior = float(np.mean(net.errors_at(at)[0] ** 2)) if hasattr(net, "errors_at") else float(net.seed_sd) ** 2
+    if prior <= 0:
+        return 1.0, dof
+    return float(np.sqrt((ss + PRIOR_DOF * prior) / (dof + PRIOR_DOF) / prior)), dof
 
 
 def saved_plan(folder: Path, obs, budget: int, stores: dict, design: str = "greedy") -> list[dict] | None:
@@ -310,7 +345,8 @@ def summary(first, second, entries: list[dict], nets: dict, obs: list[Observatio
     for q, net in nets.items():
         if isinstance(net, CorrectedNet):
             per_q[q.key] = {"runs": len(net.y), "net_rmse": net.raw_rmse(), "corrected_loo_rmse": net.loo_rmse(),
-                            "seed_sd": float(np.sqrt(np.mean(net.noise)))}
+                            "seed_sd": float(np.sqrt(np.mean(net.noise))), "seed_scale": net.seed_scale[0],
+                            "repeat_dof": net.seed_scale[1]}
     rows = [{"label": o.label, "uncertainty": o.uncertainty if o.uncertainty_given else None,
              "net_error_first": float(a), "net_error_second": float(b)}
             for o, a, b in zip(obs, first.base_model.net_errors, second.base_model.net_errors)]

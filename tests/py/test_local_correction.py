@@ -72,3 +72,17 @@ def test_near_the_runs_the_error_is_taken_out_and_far_away_the_net_comes_back():
     assert c.errors_at(far)[1][0] == pytest.approx(net.net_error, rel=1e-9)
     # the leave-one-out error of the corrected net is near the runs' scatter; the raw net's is the bump
     assert c.loo_rmse() < 0.02 < c.raw_rmse()
+
+
+def test_repeated_runs_measure_the_seed_scatter_with_the_nets_as_prior():
+    """Repeats at two points with sample variances known in closed form: the scale on the net's
+    seed scatter (0.01) is sqrt((SS + 4 * 0.01^2) / (dof + 4)) / 0.01, and it scales the runs' noise."""
+    from pydem.calibration.refine import PRIOR_DOF, local_seed_scale
+    x = np.array([[0.5, 0.5]] * 3 + [[0.2, 0.7]] * 2 + [[0.9, 0.1]])
+    y = np.array([1.0, 1.03, 0.97, 2.0, 2.04, 5.0])  # SS = 0.0018 + 0.0008, dof 2 + 1
+    keys = ["a", "a", "a", "b", "b", "c"]
+    scale, dof = local_seed_scale(SmoothNet(), x, y, keys)
+    assert dof == 3 and scale == pytest.approx(np.sqrt((0.0026 + PRIOR_DOF * 1e-4) / (3 + PRIOR_DOF)) / 0.01, rel=1e-12)
+    assert local_seed_scale(SmoothNet(), x[:1], y[:1], ["a"]) == (1.0, 0)
+    c = CorrectedNet(SmoothNet(), x, y, seed_scale=(scale, dof))
+    assert c.noise == pytest.approx(np.full(6, (0.01 * scale) ** 2)) and c.errors_at(x[:1])[0][0] == pytest.approx(0.01 * scale)
