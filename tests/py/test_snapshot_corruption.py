@@ -5,7 +5,6 @@ single-bit flips: each either fails to load with an error naming the file, or (a
 bytes) loads and runs bitwise like the original. Before the checksums, 113 of 300 such flips
 loaded and ran from a different state."""
 import numpy as np
-import pytest
 
 import pydem
 
