@@ -104,3 +104,14 @@ def test_a_slab_past_one_edge_extends_the_box_and_a_corner_left_unrun_is_refused
     with pytest.raises(PoolError, match=r"leave 3\.02 % of their joined box \(friction \[0.05, 1.2\], "
                                         r"wall_friction \[0.05, 1.2\]\) without runs"):
         joined_box(main, [slab, gap])
+
+
+def test_the_shipped_hopper_slab_extends_its_box_to_rough_walls():
+    """The hopper's wall-friction slab (1.0-1.2, every other range the size-spread store's) pools in,
+    and the hopper's box reaches 1.2; the store alone keeps 1.0."""
+    from pydem.calibration.setup import open_store_groups
+    root = Path(__file__).resolve().parents[2] / "data/campaigns"
+    main = [root / "diag_hopper_default_spread.h5", root / "diag_hopper_default.h5"]
+    assert open_store_groups(main)["hopper"][2]["wall_friction"] == (0.05, 1.0)
+    store, pooled, box = open_store_groups(main + [root / "diag_hopper_default_roughwalls.h5"])["hopper"]
+    assert store.path.name == "diag_hopper_default_spread.h5" and box["wall_friction"] == (0.05, 1.2)
