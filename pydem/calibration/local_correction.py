@@ -25,6 +25,31 @@ from .fit import NET_ERROR_LENGTH
 FLOOR = 0.05  # the corrected net error is at least this fraction of the net's own there
 
 
+def correlation(net, a, b) -> np.ndarray:
+    """(len a, len b): the net error's correlation between inputs a and b (the kernel above)."""
+    sa, sb = net.scaled(np.atleast_2d(a)), net.scaled(np.atleast_2d(b))
+    d2 = np.sum((sa[:, None, :] - sb[None, :, :]) ** 2, axis=-1)
+    return np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+
+
+def run_noise(net, x) -> np.ndarray:
+    """One run's seed-scatter variance at each of inputs x (the net's error model, else its pooled value)."""
+    x = np.atleast_2d(x)
+    seed = net.errors_at(x)[0] if hasattr(net, "errors_at") else np.full(len(x), net.seed_sd)
+    return np.asarray(seed, float) ** 2
+
+
+def left_variance(net, runs_x, targets_x) -> np.ndarray:
+    """v(x) at each target: the net-error variance left by runs at runs_x (it does not depend on
+    what the runs give: refine.plan places runs by it before any runs)."""
+    e2 = float(net.net_error) ** 2
+    if len(runs_x) == 0:
+        return np.full(len(np.atleast_2d(targets_x)), e2)
+    k = e2 * correlation(net, runs_x, runs_x) + np.diag(run_noise(net, runs_x))
+    kt = e2 * correlation(net, targets_x, runs_x)
+    return np.clip(e2 - np.sum(kt * np.linalg.solve(k, kt.T).T, axis=1), 0.0, None)
+
+
 class CorrectedNet:
     """A QuantityNet plus the Gaussian-process correction learnt from runs (x: (n, inputs) in the
     net's input order, y: (n,)); every other attribute is the net's."""
@@ -37,8 +62,7 @@ class CorrectedNet:
         self.x = np.atleast_2d(np.asarray(x, float))
         self.y = np.asarray(y, float)
         self.prior_sd = float(net.net_error)
-        seed = net.errors_at(self.x)[0] if hasattr(net, "errors_at") else np.full(len(self.y), net.seed_sd)
-        self.noise = (np.asarray(seed, float) * self.seed_scale[0]) ** 2
+        self.noise = run_noise(net, self.x) * self.seed_scale[0] ** 2
         self.residuals = self.y - net(self.x)
         k = self.prior_sd ** 2 * self._corr(self.x, self.x) + np.diag(self.noise)
         self._chol = linalg.cho_factor(k, lower=True)
@@ -53,9 +77,7 @@ class CorrectedNet:
         return self.net.scaled(np.atleast_2d(x))
 
     def _corr(self, a, b) -> np.ndarray:
-        sa, sb = self._s(a), self._s(b)
-        d2 = np.sum((sa[:, None, :] - sb[None, :, :]) ** 2, axis=-1)
-        return np.exp(-0.5 * d2 / NET_ERROR_LENGTH ** 2)
+        return correlation(self.net, a, b)
 
     def correction(self, x) -> np.ndarray:
         return self.prior_sd ** 2 * self._corr(x, self.x) @ self.alpha

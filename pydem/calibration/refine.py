@@ -34,7 +34,7 @@ from ..campaign.runner import sample_seed, simulate
 from ..campaign.workers import run_local
 from ..quantity_table import per_fraction_metric
 from .store_data import DISCHARGE_METRICS
-from .local_correction import CorrectedNet
+from .local_correction import CorrectedNet, left_variance
 from .quantities import Observation, test_conditions
 
 POSTERIOR_DRAWS = 6  # posterior draws among the target points
@@ -137,19 +137,9 @@ def plan(d, obs: list[Observation], nets: dict, candidates, ranges, budget: int)
 
     def left(q, xs) -> float:
         """Weighted net-error variance left at q's targets after runs at xs."""
-        net = nets[q]
-        e2 = float(net.net_error) ** 2
         x_t = np.array([x for x, _ in tq[q]])
         w = np.array([w for _, w in tq[q]])
-        if not xs:
-            return float(np.sum(w) * e2)
-        x_s = np.array(xs)
-        corr = lambda a, b: np.exp(-0.5 * np.sum((net.scaled(a)[:, None] - net.scaled(b)[None]) ** 2, -1))  # noqa: E731
-        noise = (net.errors_at(x_s)[0] if hasattr(net, "errors_at") else np.full(len(x_s), net.seed_sd)) ** 2
-        k = e2 * corr(x_s, x_s) + np.diag(noise)
-        kt = e2 * corr(x_t, x_s)
-        v = e2 - np.sum(kt * np.linalg.solve(k, kt.T).T, axis=1)
-        return float(np.sum(w * np.clip(v, 0.0, None)))
+        return float(np.sum(w * left_variance(nets[q], np.array(xs), x_t)))
 
     now = {q: left(q, []) for q in tq}
     picked = []
