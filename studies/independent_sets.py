@@ -22,7 +22,7 @@ runs kept in DIR/set<k>.refine, so an interrupted validation resumes run by run)
 passes; `summary` then scores the first pass too (the refinement's validation, docs/diagnosis.md §8):
 
     .venv/bin/python studies/independent_sets.py diagnose --journals studies/results/independent_sets_*.jsonl \
-        --label refined64 --out studies/results/independent_sets.refined64.json --refine 64 --runs build/refine_runs
+        --label refined16 --out studies/results/independent_sets.refined16.json --refine 16 --runs build/refine_runs16
     (and --refine-design fixed --runs build/refine_runs_fixed for the simple alternative on the same budget)
 
 The programme: ring shear at pre-shear 1, 2 and 5 kPa with shear points at 45 and 70 % (the
@@ -64,6 +64,10 @@ SEED = 7000
 # the effect sets interleaved (one of each single effect and a two-effect set per round), then the
 # last four nulls; `--part i/n` takes every n-th set of this order
 ORDER = list(range(8)) + [12, 21, 15, 18, 13, 22, 16, 19, 14, 23, 17, 20] + [8, 9, 10, 11]
+# the order sets are diagnosed in when each costs DEM runs (--refine): the twelve first (three
+# nulls and three of each single effect, one of each per round), then the two-effect sets, then the
+# other nulls, so a validation cut short has scored a balanced share
+REFINE_ORDER = [0, 12, 15, 18, 1, 13, 16, 19, 2, 14, 17, 20, 21, 22, 23] + list(range(3, 12))
 
 
 def programme(nets) -> list[Observation]:
@@ -157,7 +161,8 @@ def diagnose(args):
     import subprocess
     import tempfile
     checkout = Path(args.checkout).resolve()
-    rows = sorted((json.loads(x) for j in args.journals for x in Path(j).read_text().splitlines()), key=lambda r: r["set"])
+    rows = sorted((json.loads(x) for j in args.journals for x in Path(j).read_text().splitlines()),
+                  key=lambda r: REFINE_ORDER.index(r["set"]) if args.refine else r["set"])
     out = {"label": args.label, "checkout": str(checkout), "origin_column": not args.no_origin, "sets": []}
     if Path(args.out).exists():  # resumable: the sets diagnosed already are kept
         out["sets"] = [s for s in json.loads(Path(args.out).read_text())["sets"] if "error" not in s]
