@@ -185,11 +185,7 @@ def diagnose(args):
                 continue
             d = json.loads((res / "diagnosis.json").read_text())
             effects = d.get("effects") or ([d["effect"]] if d.get("effect") else [])
-            cover = {}
-            for name, p in d["parameters"].items():
-                truth = row["inputs"].get(name)
-                if truth is not None and p.get("lo") is not None:
-                    cover[name] = bool(p["lo"] <= truth <= p["hi"])
+            cover = covered({n: (p.get("lo"), p.get("hi")) for n, p in d["parameters"].items()}, row["inputs"])
             out["sets"].append({"set": row["set"], "kind": row["kind"], "truth_effects": row["effects"], "verdict": d["verdict"],
                                 "effects": effects, "p_best": d["candidates"][0]["p_value"] if d["candidates"] else None,
                                 "best": d["candidates"][0]["effect"] if d["candidates"] else None,
@@ -200,7 +196,9 @@ def diagnose(args):
             ref = d["context"].get("refinement")
             if ref:  # the first pass, scored as the sets were before refinement
                 first = ref["first_pass"]
-                out["sets"][-1]["first_pass"] = {"verdict": first["verdict"], "effects": first["effects"]}
+                out["sets"][-1]["first_pass"] = {"verdict": first["verdict"], "effects": first["effects"],
+                                                 "rmse_before": first.get("rmse_before"), "rmse_after": first.get("rmse_after"),
+                                                 "covered": covered(first.get("intervals", {}), row["inputs"])}
                 out["sets"][-1]["refinement"] = {"runs": ref["runs"], "failed": len(ref["failed"]),
                                                  "cpu_seconds": ref["cpu_seconds"], "quantities": ref["quantities"]}
             s = out["sets"][-1]
@@ -209,36 +207,77 @@ def diagnose(args):
             Path(args.out).write_text(json.dumps(out, indent=1))
 
 
-def summary(args):
-    """False alarms (nulls with any effect named), single effects named right (top-1), two-effect
-    sets with both named, the error after / before, and coverage, per results file."""
+def covered(intervals: dict, truth: dict) -> dict:
+    """{parameter: the truth inside its 95 % interval} for the parameters with both."""
+    return {n: bool(lo <= truth[n] <= hi) for n, (lo, hi) in intervals.items()
+            if truth.get(n) is not None and lo is not None}
+
+
+EFFECTS = ("cohesion_sjkr", "wall_friction", "size_spread")
+
+
+def score(sets: list[dict]) -> dict:
+    """One pass's figures over scored sets (each with kind, verdict, effects, rmse_before/after,
+    covered): false alarms on the nulls with their 95 % interval, top-1 per single effect, two-effect
+    sets with both named, the median error after / before, and coverage per parameter."""
     from scipy import stats
+    nulls = [s for s in sets if s["kind"] == "null"]
+    fa = sum(bool(s["effects"]) or s["verdict"] in ALARMS for s in nulls)
+    interval = (stats.beta.ppf(0.025, fa, len(nulls) - fa + 1) if fa else 0.0,
+                stats.beta.ppf(0.975, fa + 1, len(nulls) - fa) if fa < len(nulls) else 1.0)
+    top1 = {e: [s["effects"][:1] == [e] for s in sets if s["kind"] == e] for e in EFFECTS}
+    double = [sorted(s["effects"]) == sorted(s["kind"].split("+")) for s in sets if "+" in s["kind"]]
+    ratio = [s["rmse_after"] / s["rmse_before"] for s in sets
+             if s["kind"] != "null" and s.get("rmse_after") and s.get("rmse_before")]
+    names = sorted({n for s in sets for n in s["covered"]})
+    return {"nulls": len(nulls), "false_alarms": fa, "false_alarm_interval": interval,
+            "top1": {e: (sum(v), len(v)) for e, v in top1.items()}, "both": (sum(double), len(double)),
+            "error_ratio": float(np.median(ratio)) if ratio else None,
+            "coverage": {n: (sum(s["covered"][n] for s in sets if n in s["covered"]),
+                             sum(n in s["covered"] for s in sets)) for n in names}}
+
+
+def score_line(label: str, sc: dict) -> str:
+    cov = sum(a for a, _ in sc["coverage"].values()), sum(b for _, b in sc["coverage"].values())
+    lo, hi = sc["false_alarm_interval"]
+    return (f"{label}: false alarms {sc['false_alarms']}/{sc['nulls']} (95 % interval {lo:.2f}-{hi:.2f}); top-1 "
+            + ", ".join(f"{e} {a}/{b}" for e, (a, b) in sc["top1"].items())
+            + f"; two-effect sets with both {sc['both'][0]}/{sc['both'][1]}; error after/before median "
+            + (f"{sc['error_ratio']:.2f}" if sc["error_ratio"] is not None else "-")
+            + f"; coverage {cov[0]}/{cov[1]} ({100 * cov[0] / max(cov[1], 1):.0f} %): "
+            + ", ".join(f"{n} {a}/{b}" for n, (a, b) in sc["coverage"].items()))
+
+
+def summary(args):
+    """Each results file scored (score); for a refined validation the first pass of the same sets
+    too, the runs and CPU time per set, and with --markdown a per-set table."""
     for path in args.results:
         r = json.loads(Path(path).read_text())
         sets = [s for s in r["sets"] if "error" not in s]
-        nulls = [s for s in sets if s["kind"] == "null"]
-        fa = sum(bool(s["effects"]) or s["verdict"] in ALARMS for s in nulls)
-        lo, hi = (stats.beta.ppf(0.025, fa, len(nulls) - fa + 1) if fa else 0.0,
-                  stats.beta.ppf(0.975, fa + 1, len(nulls) - fa) if fa < len(nulls) else 1.0)
-        single = [s for s in sets if s["kind"] != "null" and "+" not in s["kind"]]
-        top1 = sum(s["effects"][:1] == [s["kind"]] for s in single)
-        double = [s for s in sets if "+" in s["kind"]]
-        both = sum(sorted(s["effects"]) == sorted(s["kind"].split("+")) for s in double)
-        ratio = [s["rmse_after"] / s["rmse_before"] for s in single + double if s["rmse_after"] and s["rmse_before"]]
-        cov = [c for s in sets for c in s["covered"].values()]
-        print(f"{r['label']}: false alarms {fa}/{len(nulls)} (95 % interval {lo:.2f}-{hi:.2f}); single effects named "
-              f"{top1}/{len(single)}; two-effect sets with both {both}/{len(double)}; error after/before median "
-              f"{np.median(ratio) if ratio else float('nan'):.2f}; coverage {sum(cov)}/{len(cov)} "
-              f"({100 * sum(cov) / max(len(cov), 1):.0f} %); failed runs {len(r['sets']) - len(sets)}")
-        first = [s for s in sets if "first_pass" in s]
-        if first:
-            fa1 = sum(bool(s["first_pass"]["effects"]) or s["first_pass"]["verdict"] in ALARMS for s in first
-                      if s["kind"] == "null")
-            top1_1 = sum(s["first_pass"]["effects"][:1] == [s["kind"]] for s in first if s["kind"] != "null" and "+" not in s["kind"])
-            runs = [s["refinement"]["runs"] for s in first]
-            cpu = [s["refinement"]["cpu_seconds"] / 3600 for s in first]
-            print(f"  first pass of the same sets: false alarms {fa1}, single effects named {top1_1}; refinement runs "
-                  f"per set {np.median(runs):.0f} (median), CPU {np.median(cpu):.2f} h per set (median)")
+        print(score_line(r["label"], score(sets)) + f"; failed sets {len(r['sets']) - len(sets)}")
+        refined = [s for s in sets if "first_pass" in s]
+        if not refined:
+            continue
+        first = [s | s["first_pass"] for s in refined]
+        print(score_line("  their first pass", score(first)))
+        runs = [s["refinement"]["runs"] for s in refined]
+        cpu = [s["refinement"]["cpu_seconds"] / 3600 for s in refined]
+        print(f"  refinement runs per set {np.median(runs):.0f} (median; {sum(s['refinement']['failed'] for s in refined)} "
+              f"failed in all), their CPU {np.median(cpu):.2f} h per set (median, max {max(cpu):.2f}); whole refined "
+              f"diagnosis {np.median([s['seconds'] for s in refined]) / 3600:.2f} h of wall time per set (median)")
+        if args.markdown:
+            lines = ["| set | kind | first pass | refined | error after/before: first, refined | coverage: first, refined "
+                     "| runs (failed) | run CPU (h) | wall (h) |", "|---|---|---|---|---|---|---|---|---|"]
+            for s in refined:
+                f = s["first_pass"]
+                ratio = lambda d: f"{d['rmse_after'] / d['rmse_before']:.2f}" if d.get("rmse_after") else "-"  # noqa: E731
+                cov = lambda c: f"{sum(c.values())}/{len(c)}"  # noqa: E731
+                lines.append(f"| {s['set']} | {s['kind']} | {'+'.join(f['effects']) or f['verdict']} | "
+                             f"{'+'.join(s['effects']) or s['verdict']} | {ratio(f)}, {ratio(s)} | {cov(f['covered'])}, "
+                             f"{cov(s['covered'])} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
+                             f"{s['refinement']['cpu_seconds'] / 3600:.2f} | {s['seconds'] / 3600:.2f} |")
+            Path(args.markdown).write_text("\n".join(lines) + "\n")
+            print(f"  per-set table: {args.markdown}")
 
 
 def main() -> int:
@@ -259,6 +298,7 @@ def main() -> int:
     dg.add_argument("--refine-design", default="greedy", choices=("greedy", "fixed"), help="pydem diagnose --refine-design")
     sm = sub.add_parser("summary")
     sm.add_argument("results", nargs="+")
+    sm.add_argument("--markdown", help="a refined validation's per-set table, as Markdown, into this file")
     args = ap.parse_args()
     {"run": run, "diagnose": diagnose, "summary": summary}[args.cmd](args)
     return 0

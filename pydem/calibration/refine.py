@@ -350,5 +350,9 @@ def summary(first, second, entries: list[dict], nets: dict, obs: list[Observatio
 def _pass(d) -> dict:
     """One pass as the report compares it: verdict, base fit, and the final model's estimates."""
     final = d.after if d.after is not None else d.base
+    post = final.posterior.get("parameters", {})
     return {"verdict": d.verdict, "effects": d.effects, "estimate": d.base.as_dict(),
-            "chi2_per_dof": d.base.chi2_per_dof, "final_estimate": final.as_dict()}
+            "chi2_per_dof": d.base.chi2_per_dof, "final_estimate": final.as_dict(),
+            "intervals": {n: [post[n].get("lo"), post[n].get("hi")] for n in final.names if n in post},
+            "rmse_before": d.summary_of(d.base, d.base_model)["rmse_relative"],
+            "rmse_after": d.summary_of(d.after, d.after_model)["rmse_relative"] if d.after is not None else None}
