@@ -1,7 +1,7 @@
 """`pydem diagnose`: where the base model fails against a measurement file, which candidate
 effect is missing, and the error before and after adding it (docs/diagnosis.md).
 
-    pydem diagnose data/measurements/synthetic_cohesive.csv --material synthetic_cohesive --out build/diagnosis
+    pydem diagnose data/measurements/synthetic_cohesive.csv --material synthetic_cohesive   # report in build/diagnosis/synthetic_cohesive
 """
 from __future__ import annotations
 
@@ -10,12 +10,12 @@ import time
 from pathlib import Path
 
 from . import output_dir
-from .cli_inputs import add_common, load_inputs, output_checked
+from .cli_inputs import add_common, load_inputs, output_checked, output_of
 
 
 def add_parser(sub):
     p = sub.add_parser("diagnose", help="calibrate, show where the model fails, name the missing effect, add it")
-    add_common(p, "build/diagnosis")
+    add_common(p, "build/diagnosis/{material}")
     p.add_argument("--refine", type=int, default=0, metavar="N",
                    help="after the first pass, up to N DEM runs of the file's rigs where the surrogates' error decides "
                         "the answer, the surrogates corrected by them, and the diagnosis again (runs kept, resumable, in "
@@ -36,6 +36,7 @@ def main(args) -> int:
     from .calibration.diagnose import diagnose
     t0 = time.perf_counter()
     say = lambda msg: print(msg, flush=True)  # noqa: E731
+    args.out = output_of(args)
     if not output_checked(args.out, "diagnose"):
         return 2
     refine_dir = Path(str(args.out).rstrip("/") + ".refine")

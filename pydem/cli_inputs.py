@@ -9,15 +9,27 @@ from . import output_dir
 
 
 def add_common(p, out: str):
-    """The arguments `pydem diagnose` and `pydem calibrate` share."""
+    """The arguments `pydem diagnose` and `pydem calibrate` share. `out`: the default output
+    directory; with "{material}" in it, a folder per material (output_of)."""
     p.add_argument("measurements", help="measurement file (docs/measurements.md)")
     p.add_argument("--material", required=True)
     add_stores(p)
-    p.add_argument("--out", default=out)
+    p.add_argument("--out", default=out, help=f"output directory (default {out})")
     p.add_argument("--confirm", action="store_true", help="confirming DEM runs at the final estimate, every condition")
     p.add_argument("--threads", type=int, help="threads of the native screening and the confirming runs (default: "
                                                "OMP_NUM_THREADS when set, else the cores this process may use)")
     p.add_argument("--retrain", action="store_true", help="train the surrogates again even when cached")
+
+
+def output_of(args) -> str:
+    """--out as given, or its default with the material's name in place of "{material}" (one folder
+    per material, so diagnosing a second material never meets the first one's output); a name that
+    is not a plain file name gives "material"."""
+    import re
+    if "{material}" not in args.out:
+        return args.out
+    name = args.material if re.fullmatch(r"[\w.+-]{1,100}", args.material) and args.material not in (".", "..") else "material"
+    return args.out.replace("{material}", name)
 
 
 def add_stores(p):

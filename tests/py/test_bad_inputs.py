@@ -2,6 +2,7 @@
 names the problem and a non-zero exit code — never a traceback, never exit 0 with an invented
 result. Run alone (`pytest tests/py/test_bad_inputs.py -v`) it is the probe count of the
 robustness issue."""
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -46,13 +47,13 @@ PROBES = [  # (argv with {file} placeholders, words the message must contain)
     (["campaign", "status", "{tmp}/none.h5"], "no such campaign store"),
     (["campaign", "run", "{int_range.toml}", "--store", "{tmp}/s.h5"], "ranges.particles: a design samples values "
                                                                        "between the ends, and particles: expected a whole number"),
-    (["campaign", "export", "data/campaigns/aor_tiny.h5", "--csv", "/nonexistent/x.csv"], "No such file or directory"),
+    (["campaign", "export", str(ROOT / "data/campaigns/aor_tiny.h5"), "--csv", "/nonexistent/x.csv"], "No such file or directory"),
     (["compare", "{g_cm3.csv}", "--material", "x", "--dem", "r.json"], "is outside the physically possible range"),
     (["compare", "{unknown_test.csv}", "--material", "x", "--dem", "r.json"], "unknown test 'silo'"),
     (["compare", "{dup.csv}", "--material", "x", "--dem", "r.json"], "duplicate of line 2"),
     (["compare", "{neg_u.csv}", "--material", "x", "--dem", "r.json"], "must be positive"),
     (["compare", "{cond.csv}", "--material", "x", "--dem", "r.json"], "unknown condition 'sigma'"),
-    (["calibrate", "{hopper_only.csv}", "--material", "x", "--stores", "data/campaigns/diag_aor_tiny.h5",
+    (["calibrate", "{hopper_only.csv}", "--material", "x", "--stores", str(ROOT / "data/campaigns/diag_aor_tiny.h5"),
       "--out", "{tmp}/cal"], "can be compared with the campaigns"),
     (["calibrate", "{hopper_only.csv}", "--material", "x", "--samples", "0", "--out", "{tmp}/cal"],
      "--samples must lie in 1..4194304"),
@@ -79,7 +80,9 @@ def test_probe_gives_a_clean_error(tmp_path, argv, words):
         for k, v in f.items():
             a = a.replace("{" + k + "}", v)
         args.append(a.replace("{tmp}", str(tmp_path)))
-    r = subprocess.run([sys.executable, "-m", "pydem", *args], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    # run in the test's own folder: a default --out (build/...) lands there, whatever the checkout holds
+    r = subprocess.run([sys.executable, "-m", "pydem", *args], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert r.returncode != 0, f"exit 0 for {args}: {r.stdout[-500:]}"
     assert "Traceback" not in r.stderr, r.stderr[-2000:]
     assert words in r.stderr, r.stderr[-1000:]

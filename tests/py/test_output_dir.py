@@ -52,3 +52,18 @@ def test_a_users_directory_is_never_taken_over(tmp_path):
         output_dir.check(tmp_path / "thesis.tex")
     output_dir.check(tmp_path / "new" / "deeper")  # parents are made, the output itself is not
     assert (tmp_path / "new").is_dir() and not (tmp_path / "new" / "deeper").exists()
+
+
+def test_the_default_diagnosis_output_is_one_folder_per_material():
+    """`pydem diagnose` without --out writes build/diagnosis/<material>: a second material never
+    meets the first one's output (or the demo's); a name that is no plain file name is not a path."""
+    import argparse
+    from pydem.cli_inputs import output_of
+    ap = argparse.ArgumentParser()
+    sub = ap.add_subparsers(dest="cmd")
+    from pydem import cli_diagnose
+    cli_diagnose.add_parser(sub)
+    args = lambda *a: ap.parse_args(["diagnose", "m.csv", *a])  # noqa: E731
+    assert output_of(args("--material", "iron_ore-2")) == "build/diagnosis/iron_ore-2"
+    assert output_of(args("--material", "../../etc")) == "build/diagnosis/material"
+    assert output_of(args("--material", "x", "--out", "mine")) == "mine"
