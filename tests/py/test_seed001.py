@@ -59,7 +59,7 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert p2p["settings"]["test_cases"] == ["A-5", "B1-5", "B2-5", "B3-5", "B4-5"]
     lco = p2p["splits"]["leave_cases_out"]
     assert set(lco["test"]["case"]) == set(p2p["settings"]["test_cases"])  # whole cases held out
-    proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, say=lambda *a: None)
+    proc = ex.process(SUBSET, tmp_path, size=32, window=2, epochs=1, fraction=0.4, finetune_epochs=2, say=lambda *a: None)
     assert set(proc["per_packing"]) == {"A", "B1", "B2", "B3", "B4"}
     assert proc["settings"]["protocol"] == "pretrained"
     assert all(set(v) == {"net", "baseline", "zero_shot", "fill_level", "species"} for v in proc["per_packing"].values())
@@ -71,7 +71,7 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert "Grey relational analysis" in text and "AlexNet-FC point to point" in text and "data:image/png;base64," in text
     assert json.loads((tmp_path / "process.json").read_text())["settings"]["window"] == 2
     # the network on the two species' channels: same protocol, same gauges
-    sp = ex.process(SUBSET, tmp_path / "species", size=32, window=2, epochs=1, fraction=0.4, inputs="species",
+    sp = ex.process(SUBSET, tmp_path / "species", size=32, window=2, epochs=1, fraction=0.4, finetune_epochs=2, inputs="species",
                     say=lambda *a: None)
     assert sp["settings"]["inputs"] == "species" and set(sp["per_packing"]) == set(proc["per_packing"])
     assert sp["cases"]["B1-1"]["species"] == proc["cases"]["B1-1"]["species"]  # the gauges do not depend on it
