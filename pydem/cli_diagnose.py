@@ -72,9 +72,10 @@ def main(args) -> int:
                     refine.plan_fixed(d, obs, setup.candidates, setup.ranges, args.refine))
             refine.save_plan(refine_dir, runs, obs, args.refine, setup.stores, args.refine_design)
         import os
+        from .campaign.workers import WorkerStartError
         try:
             entries = refine.run_plan(runs, setup.stores, refine_dir, args.workers or os.cpu_count() or 1, say, args.dask)
-        except (ImportError, OSError, TimeoutError) as exc:
+        except (WorkerStartError, OSError, TimeoutError) as exc:
             print(f"pydem diagnose: the refinement runs cannot start ({exc}); runs done so far are kept in {refine_dir}",
                   file=sys.stderr)
             return 2

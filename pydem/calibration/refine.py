@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign.runner import sample_seed, simulate
-from ..campaign.workers import run_local
+from ..campaign.workers import run_dask, run_local
 from ..quantity_table import per_fraction_metric
 from .store_data import DISCHARGE_METRICS
 from .local_correction import CorrectedNet, left_variance
@@ -246,12 +246,7 @@ def run_plan(runs: list[dict], stores: dict, folder: Path, workers: int, say=pri
             + (f" (run {i}: {entry['error']})" if "error" in entry else ""))
 
     if dask:
-        from distributed import Client, as_completed
-        with Client(dask, timeout="30s") as client:
-            futures = {client.submit(simulate, *a, pure=False, key=f"pydem-refine-{i}-{a[2]}"): i for i, a in jobs.items()}
-            index = {f.key: i for f, i in futures.items()}
-            for fut in as_completed(list(futures)):
-                on_result(index[fut.key], fut.result())
+        run_dask(dask, jobs, simulate, on_result, "pydem-refine")
     else:
         run_local(jobs, simulate, max(1, min(workers, len(jobs))), on_result, say)
     missing = [i for i in range(len(runs)) if i not in done]

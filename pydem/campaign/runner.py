@@ -209,19 +209,11 @@ class Campaign:
             raise StoreError(f"{self.store.path}: {exc}") from None
 
     def _run_dask(self, address, args, progress):
+        from .workers import WorkerStartError, run_dask
         try:
-            from distributed import Client, as_completed
-        except ImportError:
-            raise StoreError("--dask needs the 'distributed' package (pip install distributed)") from None
-        try:
-            client = Client(address, timeout="30s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise StoreError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
-        with client:
-            futures = {client.submit(simulate, *a, pure=False, key=f"pydem-sample-{i}-{a[2]}"): i for i, a in args.items()}
-            index = {f.key: i for f, i in futures.items()}
-            for fut in as_completed(list(futures)):
-                self._finish(index[fut.key], fut.result(), progress)
+            run_dask(address, args, simulate, lambda i, out: self._finish(i, out, progress), "pydem-sample")
+        except WorkerStartError as exc:
+            raise StoreError(str(exc)) from None
 
     def status_text(self) -> str:
         s = self.store

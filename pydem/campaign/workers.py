@@ -1,4 +1,5 @@
-"""Local campaign runs, one fresh worker process per run, at most `workers` at a time.
+"""Campaign runs in local worker processes (run_local: one fresh process per run, at most
+`workers` at a time) or on a Dask cluster (run_dask).
 
 Why not a ProcessPoolExecutor: when one of its workers dies (the out-of-memory killer, a
 `kill -9`), the whole pool breaks and the other workers' runs in progress are thrown away. Here
@@ -133,3 +134,23 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
             p.join()
             recv.close()
     sys.stderr.flush()
+
+
+def run_dask(address: str, jobs: dict, func: Callable, on_result: Callable[[int, dict], None], key: str,
+             timeout: str = "30s"):
+    """Each job's func(*args) on the Dask scheduler at `address`, on_result(i, result) as each ends
+    (in the calling thread). Task keys are <key>-<i>-<last argument, the seed>: a resubmitted run
+    is another task. WorkerStartError names a missing `distributed` or an unreachable scheduler."""
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise WorkerStartError("--dask needs the 'distributed' package (pip install distributed)") from None
+    try:
+        client = Client(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise WorkerStartError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
+    with client:
+        futures = {client.submit(func, *a, pure=False, key=f"{key}-{i}-{a[-1]}"): i for i, a in jobs.items()}
+        index = {f.key: i for f, i in futures.items()}
+        for fut in as_completed(list(futures)):
+            on_result(index[fut.key], fut.result())

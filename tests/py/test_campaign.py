@@ -220,6 +220,16 @@ def test_dask_local_cluster(tmp_path):
     assert np.all(np.isfinite(s.values[:, s.metric_names.index("angle_of_repose")]))
 
 
+def test_an_unreachable_dask_scheduler_is_named():
+    """The campaigns' and the refinement's shared Dask runner (workers.run_dask) names the address
+    it cannot reach, and runs nothing."""
+    from pydem.campaign.workers import WorkerStartError, run_dask
+    got = []
+    with pytest.raises(WorkerStartError, match="cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'"):
+        run_dask("tcp://127.0.0.1:9", {0: ("spec", {}, 1)}, simulate, lambda i, r: got.append(i), "t", timeout="1s")
+    assert got == []
+
+
 def test_status_states_throughput_and_time_left(tmp_path, monkeypatch):
     """Runs per hour = workers x 3600 / mean wall time of the finished runs (the mean: slow runs
     cost their whole time); the pending runs' time left follows from it."""
