@@ -4,11 +4,10 @@ its three pretraining-fold cases; here they are calibrated again with M more hop
 packing added, drawn like Table 1's, and the errors compared — of each gauge, and of the one a
 user would pick by leave-one-hopper-out on the training hoppers (`chosen`).
 
-The hoppers are drawn by pydem.rigs.table1.draw_like_table1. Each runs
-at full size with a frame every `--frame-interval` into its own store (resumable: hoppers
-already stored are skipped), two at a time.
+The hoppers are made by `pydem images hoppers` (pydem/seed001/hoppers.py: drawn like Table 1's,
+full size, a frame every 1 ms, one resumable store per packing):
 
-    .venv/bin/python studies/nrrp_more_hoppers.py run --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
+    .venv/bin/pydem images hoppers --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
     .venv/bin/python studies/nrrp_more_hoppers.py evaluate --packing B1 --store data/seed001/extra_B1.h5 \\
         --table1 data/seed001/frames_full.h5 --out studies/results/seed001/nrrp_more_hoppers_B1.json
 """
@@ -17,52 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-
-
-def run_one(name: str, row: tuple, packing: str, frame_interval: float):
-    from pydem.rigs import RIGS, load
-    from pydem.rigs.hopper import apply_row
-    cls, cfg_cls = RIGS["hopper"]
-    cfg = load(cfg_cls, "default", None, [f"frame_interval={frame_interval}", "num_threads=1"])
-    apply_row(cfg, row, packing)
-    t0 = time.perf_counter()
-    try:
-        res = cls(cfg).run(seed=0, images=True)
-    except Exception as exc:  # one hopper that fails does not stop the others
-        return name, None, f"failed ({exc})"
-    t_dis = res.metrics["discharge_time"].value
-    if not np.isfinite(t_dis):
-        return name, None, f"did not empty ({res.metrics['discharge_time'].note})"
-    return name, (res.images, res.series["frame_time"], t_dis, res.series["frame_nrrp"]), time.perf_counter() - t0
-
-
-def run(args) -> int:
-    from pydem.seed001.store import FrameStore
-    from pydem.rigs.table1 import draw_like_table1
-    store = FrameStore(args.store)
-    rows = draw_like_table1(args.packing, args.hoppers, args.seed)
-    todo = {k: v for k, v in rows.items() if k not in set(store.cases())}
-    print(f"{len(rows) - len(todo)} of {len(rows)} hoppers stored; running {len(todo)}, {args.workers} at a time")
-    with ProcessPoolExecutor(args.workers) as pool:
-        jobs = [pool.submit(run_one, k, v, args.packing, args.frame_interval) for k, v in todo.items()]
-        for job in as_completed(jobs):  # stored as each finishes: a killed run keeps what it made
-            name, got, info = job.result()
-            if got is None:
-                print(f"  {name}: {info}; not stored")
-                continue
-            frames, t, t_dis, nrrp = got
-            store.write_case(name, frames, t, t_dis, nrrp, {"packing": args.packing, "row": json.dumps(rows[name]),
-                                                             "frame_interval": args.frame_interval, "dem_seconds": info})
-            print(f"  {name}: N {rows[name][0]}, {len(frames)} frames, discharge {t_dis:.3f} s, {info:.0f} s", flush=True)
-    return 0
 
 
 def evaluate(args) -> int:
@@ -120,13 +79,6 @@ def calibrated(case: str, inputs: dict, nrrp: dict, train: list[str], k: int) ->
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run")
-    r.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
-    r.add_argument("--hoppers", type=int, default=12)
-    r.add_argument("--seed", type=int, default=1)
-    r.add_argument("--store", required=True)
-    r.add_argument("--frame-interval", type=float, default=0.001)
-    r.add_argument("--workers", type=int, default=2)
     e = sub.add_parser("evaluate")
     e.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
     e.add_argument("--store", required=True)
@@ -134,7 +86,7 @@ def main() -> int:
     e.add_argument("--size", type=int, default=224, help="frame side of the fill-level gauge")
     e.add_argument("--out", required=True)
     args = ap.parse_args()
-    return run(args) if args.cmd == "run" else evaluate(args)
+    return evaluate(args)
 
 
 if __name__ == "__main__":

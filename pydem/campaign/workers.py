@@ -80,7 +80,7 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
         p = ctx.Process(target=_worker, args=(send, parent, func, jobs[i]), daemon=True)
         p.start()
         send.close()
-        running[p.sentinel] = (i, p, recv, time.perf_counter())
+        running[p.sentinel] = [i, p, recv, time.perf_counter(), None]
 
     try:
         while queue or running:
@@ -88,8 +88,11 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
                 start(queue.pop(0))
             if not running:
                 break
+            # the results are read as they come, not when the worker has exited: a result larger than
+            # the pipe's buffer (64 KiB: a hopper's frames) blocks its worker until it is read
+            reading = {r[2]: r for r in running.values() if r[4] is None}
             try:
-                ready = wait(list(running), timeout=1.0)
+                ready = wait(list(running) + list(reading), timeout=1.0)
             except KeyboardInterrupt as exc:
                 if interrupted is not None:
                     raise
@@ -97,13 +100,19 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
                 if say:
                     say(f"interrupted: waiting for {len(running)} running run(s) to finish (Ctrl-C again to stop them)")
                 continue
-            for sentinel in ready:
-                i, p, recv, t0 = running.pop(sentinel)
-                out = None
+            for conn in (r for r in ready if r in reading):
                 try:
-                    if recv.poll():
-                        out = recv.recv()
-                except (EOFError, OSError):
+                    reading[conn][4] = conn.recv()
+                except (EOFError, OSError):  # the worker died before it sent: its sentinel follows
+                    reading[conn][4] = False
+            for sentinel in (r for r in ready if r in running):
+                i, p, recv, t0, out = running.pop(sentinel)
+                if out is None:
+                    try:
+                        out = recv.recv() if recv.poll() else None
+                    except (EOFError, OSError):
+                        out = None
+                if out is False:  # the pipe closed with no result
                     out = None
                 recv.close()
                 p.join()
@@ -129,7 +138,7 @@ def run_local(jobs: dict, func: Callable, workers: int, on_result: Callable[[int
         if interrupted is not None:
             raise interrupted
     finally:
-        for i, p, recv, _ in running.values():  # only on an error or a second Ctrl-C
+        for i, p, recv, _, _ in running.values():  # only on an error or a second Ctrl-C
             p.kill()
             p.join()
             recv.close()

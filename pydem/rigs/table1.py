@@ -43,11 +43,12 @@ def species_counts(n: int, d_small: float, d_large: float, fine_fraction: float)
     return int(n_fine), int(n - n_fine)
 
 
-def draw_like_table1(packing: str, hoppers: int, seed: int) -> dict[str, tuple]:
+def draw_like_table1(packing: str, hoppers: int, seed: int, volume_scale: float = 1.0) -> dict[str, tuple]:
     """{name: row} of `hoppers` hoppers drawn like Table 1's (named <packing>-x01 ...): each
     parameter from the values its column holds over the 25 cases, independently, and the sphere
     count from the drawn sizes and fine fraction and the solid volume of a Table 1 case drawn at
-    random (the seed keeps the bed's volume roughly fixed)."""
+    random (the seed keeps the bed's volume roughly fixed), times volume_scale (1: Table 1's beds;
+    smaller for a quick look). The first k hoppers are the same whatever `hoppers` is."""
     import numpy as np
     rows = list(TABLE1.values())
     rng = np.random.default_rng(seed)
@@ -56,9 +57,9 @@ def draw_like_table1(packing: str, hoppers: int, seed: int) -> dict[str, tuple]:
     for i in range(hoppers):
         nu, e, phi, epp, ewp, mupp, muwp, mur, dd, rho = (pick(c) for c in range(1, 11))
         like = rows[rng.integers(len(rows))]  # the bed's solid volume of a Table 1 case
-        volume = solid_volume(like)
+        volume = solid_volume(like) * volume_scale
         vs, vl = (math.pi / 6 * (d / 1000.0) ** 3 for d in dd)
-        n = int(round(volume * phi / vs + volume * (1 - phi) / vl))
+        n = max(2, int(round(volume * phi / vs + volume * (1 - phi) / vl)))
         out[f"{packing}-x{i + 1:02d}"] = (n, nu, e, phi, epp, ewp, mupp, muwp, mur, dd, rho)
     return out
 

@@ -5,6 +5,7 @@ the 11 Table 1 parameters against the cases' discharge times (pydem.seed001.gra)
 
     .venv/bin/python -m pydem.seed001 frames --store data/seed001/frames.h5 [--cases A-1 B1-3] [--frame-interval 0.02]
     .venv/bin/python -m pydem.seed001 gra --store data/seed001/frames.h5
+    .venv/bin/python -m pydem.seed001 hoppers --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
     .venv/bin/python -m pydem.seed001 subset --store data/seed001/frames_full.h5 --out data/seed001/frames_subset.h5 --every 25
     .venv/bin/python -m pydem.seed001 compare|point-to-point|process --store STORE --out DIR [--size 64 --epochs N]
     .venv/bin/python -m pydem.seed001 report --store STORE --results DIR --out DIR
@@ -70,6 +71,17 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
     f.add_argument("--cases", nargs="+", default=list(TABLE1), choices=list(TABLE1))
     f.add_argument("--frame-interval", type=float, default=0.02, help="s between frames (default 0.02)")
     f.add_argument("--threads", type=int, default=1)
+    h = sub.add_parser("hoppers", help="more hoppers of a packing, drawn like Table 1's, into a frame store of their "
+                                       "own: pretraining and calibration data, never test cases (resumable)")
+    h.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
+    h.add_argument("--hoppers", type=int, default=12, help="how many (the first k are the same for any count; default 12)")
+    h.add_argument("--store", required=True, help="the packing's frame store, e.g. data/seed001/extra_B1.h5")
+    h.add_argument("--seed", type=seed_value, default=1, help="the draw's seed (default 1)")
+    h.add_argument("--frame-interval", type=float, default=0.001, help="s between frames (default 0.001)")
+    h.add_argument("--workers", type=int, default=2)
+    h.add_argument("--volume-scale", type=float, default=1.0,
+                   help="the beds' solid volume over Table 1's (default 1; smaller for a quick look)")
+    h.add_argument("--retry-failed", action="store_true", help="run the hoppers that failed before again")
     g = sub.add_parser("gra", help="grey relational analysis of the stored cases' discharge times")
     g.add_argument("--store", required=True)
     g.add_argument("--rho", type=float, default=0.5)
@@ -111,6 +123,16 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
     if args.cmd == "report":
         from .report import write
         print(f"written {write(args.store, args.results, args.out)}")
+        return 0
+    if args.cmd == "hoppers":
+        from .hoppers import run_hoppers
+        try:
+            got = run_hoppers(args.store, args.packing, args.hoppers, args.seed, args.frame_interval, args.workers,
+                              args.volume_scale, args.retry_failed, say=lambda m: print(m, flush=True))
+        except ValueError as exc:
+            print(f"pydem images hoppers: {exc}", file=sys.stderr)
+            return 2
+        print(f"{args.store}: {len(got['stored'])} of {args.hoppers} hoppers stored, {len(got['failed'])} failed")
         return 0
     if args.cmd == "frames":
         run_frames(args.store, args.cases, args.frame_interval, args.threads)

@@ -65,6 +65,35 @@ class FrameStore:
             if case in g:
                 del g[case]
             g.move(tmp, case)
+            if case in f.get("failed", {}):  # run again and stored: no longer a failure
+                del f["failed"][case]
+
+    def write_failure(self, case: str, reason: str, attrs: dict | None = None):
+        """A case that ran and could not be stored (a runaway overlap, a bed that did not empty),
+        kept with its reason under failed/<case> so a rerun reports it instead of losing it."""
+        import h5py
+        with h5py.File(self.path, "a") as f:
+            g = f.require_group("failed")
+            if case in g:
+                del g[case]
+            c = g.create_group(case)
+            c.attrs["reason"] = reason
+            for k, v in (attrs or {}).items():
+                c.attrs[k] = v
+
+    def failures(self) -> dict:
+        """{case: its attributes, "reason" among them} of the failures kept (write_failure)."""
+        import h5py
+        if not self.path.exists():
+            return {}
+        with h5py.File(self.path, "r") as f:
+            return {k: dict(g.attrs) for k, g in f.get("failed", {}).items()}
+
+    def attrs_of(self, case: str) -> dict:
+        """A stored case's attributes, without reading its frames."""
+        import h5py
+        with h5py.File(self.path, "r") as f:
+            return dict(f["frames"][case].attrs)
 
     def read_case(self, case: str) -> dict:
         import h5py

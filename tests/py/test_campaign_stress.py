@@ -118,3 +118,15 @@ def test_kills_and_polling_lose_nothing(tmp_path):
         assert final.status[i] == DONE and tuple(np.round(final.values[i], 12)) == row
     assert not list(tmp_path.glob(".c.h5.tmp-*")) and not (tmp_path / "c.h5.lock").exists()
     assert worker_kills >= 1 and campaign_kills >= 1
+
+
+def test_a_result_larger_than_the_pipe_reaches_the_parent():
+    """A worker's result far beyond the pipe's 64 KiB buffer (a hopper's frames are megabytes) is
+    read while the worker is still sending it: before, the worker blocked in its send and the
+    parent waited for it to exit, for ever. Run in a child with a time limit, so a deadlock fails."""
+    code = ("import numpy as np\nfrom pydem.campaign.workers import run_local\ngot = {}\n"
+            "run_local({0: ((2_000_000,),), 1: ((10,),), 2: ((300_000,),)}, np.ones, 2, lambda i, r: got.update({i: r.sum()}))\n"
+            "assert got == {0: 2e6, 1: 10.0, 2: 3e5}, got\nprint('ok')\n")
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert r.returncode == 0 and "ok" in r.stdout, r.stderr[-2000:]

@@ -1,0 +1,102 @@
+"""More hoppers per packing, drawn like Table 1's, as a data set of their own: seed 001's networks
+and image gauges pretrain and calibrate on them and never test on them (the 25 Table 1 cases stay
+the test set). The measured reason (docs/seed001.md): within one discharge the frames fix the
+count, and what fails is carrying the image-to-count law to a new hopper from three others.
+
+Each hopper is a Table 1-style row drawn by pydem.rigs.table1.draw_like_table1 (named
+<packing>-x01, -x02 ...; the same draws for a given seed whatever the count asked), run at full
+size with a frame every `frame_interval` s in its own worker process (campaign.workers.run_local:
+a killed worker costs its own run only), and written whole into one frame store per packing as it
+ends. A rerun does the hoppers the store lacks; a hopper that failed is kept in the store with its
+reason (FrameStore.failures) and reported, and run again only when asked."""
+from __future__ import annotations
+
+import json
+import time
+
+import numpy as np
+
+from .store import FrameStore
+
+PACKINGS = ("A", "B1", "B2", "B3", "B4")
+
+
+def run_one(name: str, row: list, packing: str, frame_interval: float) -> dict:
+    """One hopper's frames (a worker process): {"frames", "time", "discharge_time", "nrrp", "wall"}
+    or {"error": reason}."""
+    from ..rigs import RIGS, load
+    from ..rigs.hopper import apply_row
+    cls, cfg_cls = RIGS["hopper"]
+    cfg = load(cfg_cls, "default", None, [f"frame_interval={frame_interval}", "num_threads=1"])
+    apply_row(cfg, tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]), packing)
+    t0 = time.perf_counter()
+    try:
+        res = cls(cfg).run(seed=0, images=True)
+    except Exception as exc:  # a runaway overlap, a jam: kept with its reason
+        return {"error": f"the run failed ({exc})", "wall": time.perf_counter() - t0}
+    t_dis = res.metrics["discharge_time"].value
+    if not np.isfinite(t_dis):
+        return {"error": f"did not empty ({res.metrics['discharge_time'].note})", "wall": time.perf_counter() - t0}
+    return {"frames": np.asarray(res.images, np.uint8), "time": res.series["frame_time"], "discharge_time": t_dis,
+            "nrrp": res.series["frame_nrrp"], "particles": res.info["particles"], "wall": time.perf_counter() - t0}
+
+
+def drawn(packing: str, hoppers: int, seed: int, volume_scale: float = 1.0) -> dict[str, list]:
+    """{name: row} of the hoppers asked, rows as JSON-ready lists."""
+    from ..rigs.table1 import draw_like_table1
+    rows = draw_like_table1(packing, hoppers, seed, volume_scale)
+    return {k: [v[0], *v[1:9], list(v[9]), v[10]] for k, v in rows.items()}
+
+
+def run_hoppers(store_path, packing: str, hoppers: int, seed: int = 1, frame_interval: float = 0.001,
+                workers: int = 2, volume_scale: float = 1.0, retry_failed: bool = False, say=print) -> dict:
+    """Runs the hoppers the store lacks; returns {"stored": [...], "failed": {name: reason}}.
+    A store drawn with another seed, volume scale or frame interval is refused (its names would
+    mean other hoppers)."""
+    from ..campaign.workers import run_local
+    if packing not in PACKINGS:
+        raise ValueError(f"packing: one of {', '.join(PACKINGS)}, got {packing!r}")
+    if hoppers < 1 or not np.isfinite(frame_interval) or frame_interval <= 0 or not 0 < volume_scale <= 1:
+        raise ValueError(f"hoppers >= 1, frame_interval > 0 and 0 < volume_scale <= 1 are needed "
+                         f"(got {hoppers}, {frame_interval}, {volume_scale})")
+    store = FrameStore(store_path)
+    rows = drawn(packing, hoppers, seed, volume_scale)
+    settings = {"packing": packing, "draw_seed": seed, "frame_interval": frame_interval, "volume_scale": volume_scale}
+    stored, failures = set(store.cases()), store.failures()
+    for name, got in [(c, store.attrs_of(c)) for c in stored] + list(failures.items()):
+        if any(got.get(k) != v for k, v in settings.items()) or (name in rows and json.loads(got["row"]) != rows[name]):
+            made = ", ".join(f"{k} {np.asarray(got.get(k)).tolist()}" for k in settings)
+            raise ValueError(f"{store_path}: {name} was made with other settings ({made}); use another store for "
+                             + ", ".join(f"{k} {v}" for k, v in settings.items()))
+    failed = {k: str(v["reason"]) for k, v in failures.items() if k in rows}
+    todo = [k for k in rows if k not in stored and (retry_failed or k not in failed)]
+    say(f"{packing}: {len(rows)} hoppers asked, {len(stored & set(rows))} stored, {len(failed)} failed before"
+        + (" (run again)" if retry_failed and failed else (" (kept; --retry-failed runs them again)" if failed else ""))
+        + f"; running {len(todo)}, {workers} at a time")
+    for name, reason in failed.items():
+        if name not in todo:
+            say(f"  {name}: failed before: {reason}")
+    t0, ended = time.perf_counter(), 0
+
+    def on_result(i: int, res: dict):
+        nonlocal ended
+        name = todo[i]
+        ended += 1
+        attrs = settings | {"row": json.dumps(rows[name]), "dem_seconds": float(res.get("wall") or 0.0)}
+        if "error" in res:
+            store.write_failure(name, res["error"], attrs)
+            failed[name] = res["error"]
+            what = f"failed: {res['error']}"
+        else:
+            store.write_case(name, res["frames"], res["time"], res["discharge_time"], res["nrrp"],
+                             attrs | {"particles": res["particles"]})
+            failed.pop(name, None)
+            what = f"N {rows[name][0]}, {len(res['frames'])} frames, discharge {res['discharge_time']:.3f} s"
+        left = (time.perf_counter() - t0) / ended * (len(todo) - ended)
+        say(f"  {name}: {what}, {res.get('wall') or 0:.0f} s; {ended}/{len(todo)} done, "
+            f"{sum(k in failed for k in todo)} failed, ~{left / 60:.0f} min left")
+
+    if todo:
+        run_local({i: (name, rows[name], packing, frame_interval) for i, name in enumerate(todo)}, run_one,
+                  max(1, min(workers, len(todo))), on_result, say)
+    return {"stored": sorted(set(store.cases()) & set(rows)), "failed": failed}
