@@ -1,7 +1,7 @@
 """The image gauges beside a finished CNN-LSTM `process` run (pretrained protocol), without
 training anything: for every case the NRRP after its first 20 % of frames as the fill-level
 gauge and the species gauge read it, each calibrated on the cases in the folds the case's
-network pretrained on (pydem.seed001.experiments.gauge_rows), scored like the network — for runs
+network pretrained on (pydem.seed001.gauges), scored like the network — for runs
 made before the gauges were part of `process`, or on another machine. Beside them, the same
 gauges fitted on the case's own whole discharge (`*_own`: quintics; what no reader of a new
 hopper has): how well one discharge's frames fix its own count, against how well a law carries
@@ -24,8 +24,8 @@ sys.path.insert(0, str(ROOT))
 
 
 def main() -> int:
-    from pydem.seed001 import frame_data
     from pydem.seed001 import experiments as ex
+    from pydem.seed001 import frame_data, gauges
     from pydem.seed001.store import FrameStore
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--store", required=True)
@@ -41,15 +41,18 @@ def main() -> int:
         raise SystemExit(f"{args.process}: protocol {st['protocol']!r}; the gauge is calibrated on pretraining cases")
     cases = FrameStore(args.store).cases()
     data = {c: frame_data.load_frames(args.store, cases=[c], size=args.size) for c in cases}
-    gauges = ex.gauge_inputs(args.store, cases, args.size)
+    g_in = gauges.inputs(args.store, cases, args.size)
+    nrrp = {c: d.nrrp for c, d in data.items()}
     folds = sorted({ex.fold_of(c) for c in cases})
     out = {"store": args.store, "size": args.size, "process": args.process, "cases": {}, "per_packing": {}}
     for c in cases:
         k = ex.first_part(len(data[c].x), st["fraction"], st["window"])
         if c not in run["cases"] or run["cases"][c]["trained_on"] != k:
             raise SystemExit(f"{c}: not in {args.process} with the same first part — another frame store?")
-        row = {g: v for g, v in ex.gauge_rows(c, gauges, data, folds, k).items() if g in ex.GAUGES}
-        out["cases"][c] = row | own_fits(gauges[c], data[c].nrrp, k) | {"net": run["cases"][c]["net"],
+        same = [t for t in cases if ex.packing_of(t) == ex.packing_of(c)
+                and ex.fold_of(t) in ex.pretraining_folds(ex.fold_of(c), folds)]
+        row = {g: v for g, v in gauges.scored(c, same, g_in, nrrp, k).items() if g in gauges.GAUGES}
+        out["cases"][c] = row | own_fits(g_in[c], data[c].nrrp, k) | {"net": run["cases"][c]["net"],
                                                                        "baseline": run["cases"][c]["baseline"]}
         print(f"{c}: " + "  ".join(f"{g} {r['relative_error']:.3f}" for g, r in out["cases"][c].items()))
     for pk in ex.PACKINGS:
@@ -59,7 +62,7 @@ def main() -> int:
         print(f"{pk}: " + ", ".join(f"{k} {v:.3f}" for k, v in out["per_packing"][pk].items()))
     Path(args.out).write_text(json.dumps(out, indent=1))
     if args.figure:
-        figure(args.figure, gauges, data)
+        figure(args.figure, g_in, data)
     return 0
 
 

@@ -1,5 +1,5 @@
 """Would more hoppers carry the image-to-count law? The image gauges of `process`
-(pydem.seed001.experiments.gauge_rows) read the five Table 1 cases of a packing after calibrating on
+(pydem.seed001.gauges) read the five Table 1 cases of a packing after calibrating on
 its three pretraining-fold cases; here they are calibrated again with M more hoppers of the same
 packing added, drawn like Table 1's, and the errors compared — of each gauge, and of the one a
 user would pick by leave-one-hopper-out on the training hoppers (`chosen`).
@@ -26,54 +26,33 @@ sys.path.insert(0, str(ROOT))
 
 def evaluate(args) -> int:
     from pydem.seed001 import experiments as ex
+    from pydem.seed001 import frame_data, gauges
     from pydem.seed001.store import FrameStore
     table1 = [c for c in FrameStore(args.table1).cases() if ex.packing_of(c) == args.packing]
-    extra_store = FrameStore(args.store)
-    extra = extra_store.cases()
-    inputs = ex.gauge_inputs(args.table1, table1, args.size)
-    nrrp = {c: FrameStore(args.table1).read_case(c)["nrrp"] for c in table1}
-    rows = {}
-    for c in extra:
-        d = extra_store.read_case(c)
-        row = json.loads(d["row"])
-        rows[c], nrrp[c] = tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]), d["nrrp"]
-    inputs |= ex.gauge_inputs(args.store, extra, args.size, rows)
+    extra = FrameStore(args.store).cases()
+    g_in = gauges.inputs(args.table1, table1, args.size) | gauges.inputs(args.store, extra, args.size)
+    nrrp = {c: FrameStore(args.table1).read_case(c)["nrrp"] for c in table1} | \
+        {c: FrameStore(args.store).read_case(c)["nrrp"] for c in extra}
+    first = {c: ex.first_part(len(v), 0.2, 8) for c, v in nrrp.items()}
     folds = sorted({ex.fold_of(c) for c in table1})
     out = {"packing": args.packing, "size": args.size, "extra": extra, "cases": {}}
     for case in table1:
-        k = ex.first_part(len(nrrp[case]), 0.2, 8)
+        k = first[case]
         base = [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)]
         row = {}
         for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra)):
-            row[label] = calibrated(case, inputs, nrrp, train, k)
-            row[label]["chosen"] = row[label][chosen_gauge(inputs, nrrp, train)]
+            row[label] = {g: frame_data.scores(nrrp[case][k:], v)["relative_error"]
+                          for g, v in gauges.readings(case, train, g_in, nrrp, k).items()}
+            row[label]["chosen"] = row[label][gauges.chosen(g_in, nrrp, train, first)]
         out["cases"][case] = row
         print(f"{case}: " + "  ".join(f"{lab}: fill {r['fill_level']:.3f} species {r['species']:.3f} chosen {r['chosen']:.3f}"
                                       for lab, r in row.items()))
-    out["mean"] = {lab: {g: float(np.mean([out["cases"][c][lab][g] for c in table1])) for g in ex.GAUGES + ("chosen",)}
+    out["mean"] = {lab: {g: float(np.mean([out["cases"][c][lab][g] for c in table1])) for g in gauges.GAUGES + ("chosen",)}
                    for lab in ("table1", "table1+extra", "extra")}
     for lab, v in out["mean"].items():
         print(f"mean over {args.packing}, calibrated on {lab}: " + ", ".join(f"{g} {e:.3f}" for g, e in v.items()))
     Path(args.out).write_text(json.dumps(out, indent=1))
     return 0
-
-
-def chosen_gauge(inputs: dict, nrrp: dict, train: list[str]) -> str:
-    """The gauge a user would pick from the training hoppers alone: the one whose error, each
-    hopper read by a gauge calibrated on the others (from its first 20 % on), is smaller."""
-    from pydem.seed001 import experiments as ex
-    errs = [calibrated(c, inputs, nrrp, [t for t in train if t != c], ex.first_part(len(nrrp[c]), 0.2, 8))
-            for c in train]
-    return min(ex.GAUGES, key=lambda g: np.mean([e[g] for e in errs]))
-
-
-def calibrated(case: str, inputs: dict, nrrp: dict, train: list[str], k: int) -> dict:
-    """Relative errors of both gauges on the case from frame k, calibrated on `train`
-    (pydem.seed001.experiments.gauge_readings)."""
-    from pydem.seed001 import frame_data
-    from pydem.seed001 import experiments as ex
-    return {g: frame_data.scores(nrrp[case][k:], v)["relative_error"]
-            for g, v in ex.gauge_readings(case, train, inputs, nrrp, k).items()}
 
 
 def main() -> int:

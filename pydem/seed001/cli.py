@@ -115,6 +115,14 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
                            help="what the network sees of a frame: grey (seed 001's) or species (fine and coarse "
                                 "spheres as two channels, read from the grey levels)")
             e.add_argument("--stride", type=int, default=4, help="pretraining windows every N frames (default 4)")
+            e.add_argument("--extra", nargs="+", default=[], metavar="STORE",
+                           help="frame stores of more hoppers (pydem images hoppers): pretraining and gauge "
+                                "calibration only, never tested")
+            e.add_argument("--extra-per-packing", type=int, metavar="K",
+                           help="the first K extra hoppers of each packing only (the curve of error against hoppers)")
+            e.add_argument("--target", choices=("nrrp", "residual"), default="nrrp",
+                           help="what the network learns: the NRRP (default), or its residual on the image gauge "
+                                "chosen per packing from the training hoppers")
     rp = sub.add_parser("report", help="HTML + Markdown report of the GRA and the experiments' results")
     rp.add_argument("--store", required=True)
     rp.add_argument("--results", required=True, help="the experiments' --out directory")
@@ -154,9 +162,14 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
             kw |= {k: v for k, v in (("models", args.models), ("time_budget", args.time_budget)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
-            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride}
+            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride, "extra": args.extra,
+                   "extra_per_packing": args.extra_per_packing, "target": args.target}
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
-        run(args.store, args.out, size=args.size, seed=args.seed, **kw)
+        try:
+            run(args.store, args.out, size=args.size, seed=args.seed, **kw)
+        except ValueError as exc:  # settings or stores that cannot go together, named
+            print(f"pydem images {args.cmd}: {exc}", file=sys.stderr)
+            return 2
         return 0
     store = FrameStore(args.store)
     discharge = {c: float(store.read_case(c)["discharge_time"]) for c in store.cases()}

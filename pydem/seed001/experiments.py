@@ -30,7 +30,7 @@ import torch
 from nn import cnn, training
 
 from ..progress import EpochProgress
-from . import baselines, frame_data
+from . import baselines, frame_data, gauges
 from .store import FrameStore
 
 PACKINGS = ("A", "B1", "B2", "B3", "B4")
@@ -156,23 +156,46 @@ def fold_of(case: str) -> str:
     return case.rsplit("-", 1)[1]
 
 
-def _nrrp_windows(f: frame_data.Frames, window: int, stride: int = 1):
-    return training.windows(f.x, f.nrrp.astype(np.float32), window, stride)
+def _nrrp_windows(f: frame_data.Frames, window: int, stride: int = 1, base: np.ndarray | None = None):
+    """Windows of the case's frames and their targets: the NRRP, or its residual on `base` (the
+    chosen gauge's reading of every frame)."""
+    y = f.nrrp if base is None else f.nrrp - base
+    return training.windows(f.x, y.astype(np.float32), window, stride)
 
 
-def _read_later(model, f: frame_data.Frames, k: int, window: int, scaling: dict) -> np.ndarray:
-    """The NRRP of every frame from k on, read from the window of `window` frames ending there."""
+def _read_later(model, f: frame_data.Frames, k: int, window: int, scaling: dict, base: np.ndarray | None = None) -> np.ndarray:
+    """The NRRP of every frame from k on, read from the window of `window` frames ending there (the
+    network's output, plus base[k:] when it learnt the residual on a gauge)."""
     xr, _ = training.windows(f.x[k - window + 1:], f.nrrp[k - window + 1:], window)
-    return np.clip(training.predict(model, xr, scaling).reshape(len(xr), window)[:, -1], 0.0, 1.0)
+    out = training.predict(model, xr, scaling).reshape(len(xr), window)[:, -1]
+    return np.clip(out + (0.0 if base is None else base[k:]), 0.0, 1.0)
 
 
 def _window_mse(model, xw, yw, scaling: dict) -> float:
     return float(np.mean((training.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
 
 
+def extra_hoppers(stores, table1: list[str], per_packing: int | None = None) -> dict:
+    """{case: store} of the hoppers in `stores` (pydem images hoppers), the first `per_packing` of
+    each packing when given. A name that is also a Table 1 case, or in two stores, is refused:
+    a test case must never reach the training."""
+    found: dict = {}
+    for path in stores or ():
+        for c in FrameStore(path).cases():
+            if c in table1 or c in found:
+                raise ValueError(f"{path}: {c} is {'a Table 1 case' if c in table1 else 'in ' + str(found[c])} too; "
+                                 f"extra hoppers must be other hoppers")
+            found[c] = path
+    if per_packing is not None:
+        keep = {c for pk in PACKINGS for c in sorted(x for x in found if packing_of(x) == pk)[:per_packing]}
+        found = {c: v for c, v in found.items() if c in keep}
+    return found
+
+
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
-            device: str = "auto", inputs: str = "grey", say=print) -> dict:
+            device: str = "auto", inputs: str = "grey", extra=(), extra_per_packing: int | None = None,
+            target: str = "nrrp", say=print) -> dict:
     """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
 
     protocol "per-case" (seed 001's): the CNN-LSTM trained on windows of the case's first
@@ -185,38 +208,67 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     case's own held-back early windows. The zero-shot prediction (no frame of the case seen) is
     reported beside it. In both, each later frame's NRRP is read from the window ending at it.
     `inputs`: what the network sees of a frame (frame_data.INPUTS): the grey frame, seed 001's, or
-    its two species (fine, coarse) as separate channels."""
+    its two species (fine, coarse) as separate channels.
+
+    Pretrained only: `extra`, frame stores of more hoppers (pydem images hoppers; the first
+    `extra_per_packing` of each packing when given), join every fold's pretraining and the gauges'
+    calibration — never its validation or test. `target` "residual": the network learns the NRRP
+    minus the reading of the gauge chosen, per packing, from the fold's training hoppers alone
+    (gauges.chosen; on a training hopper the gauge calibrated on the others, gauges.cross_fitted),
+    and adds that reading back."""
     if protocol not in ("pretrained", "per-case"):
         raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
+    if target not in ("nrrp", "residual"):
+        raise ValueError(f"target: 'nrrp' or 'residual', got {target!r}")
+    if protocol != "pretrained" and (extra or target != "nrrp"):
+        raise ValueError("extra hoppers and the residual target go with the pretrained protocol")
     epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
     dev = training.pick_device(device)
-    res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
-                        "protocol": protocol, "inputs": inputs, "gradient_clip": LSTM_CLIP, "device": str(dev)} | ({"stride": stride, "finetune_epochs": finetune_epochs,
-                                                  "finetune_lr": lr / 10} if protocol == "pretrained" else {}),
-           "machine": _machine(dev), "cases": {}}
     cases = FrameStore(store).cases()
-    data = {c: frame_data.load_frames(store, cases=[c], size=size, inputs=inputs) for c in cases}
+    more = extra_hoppers(extra, cases, extra_per_packing)
+    res = {"settings": {"size": size, "window": window, "epochs": epochs, "lr": lr, "seed": seed, "fraction": fraction,
+                        "protocol": protocol, "inputs": inputs, "gradient_clip": LSTM_CLIP, "device": str(dev)}
+           | ({"stride": stride, "finetune_epochs": finetune_epochs, "finetune_lr": lr / 10, "target": target,
+               "extra_stores": [str(x) for x in extra or ()], "extra_hoppers": sorted(more)}
+              if protocol == "pretrained" else {}),
+           "machine": _machine(dev), "cases": {}}
+    data = {c: frame_data.load_frames(more.get(c, store), cases=[c], size=size, inputs=inputs) for c in cases + list(more)}
+    nrrp = {c: d.nrrp for c, d in data.items()}
     folds = sorted({fold_of(c) for c in cases})
-    pretrained, gauges = {}, {}
+    pretrained, g_in, fold_train = {}, {}, {}
     if protocol == "pretrained":
         if len(folds) < 3:
             raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
-        whole = {c: _nrrp_windows(data[c], window, stride) for c in cases if len(data[c].x) >= window}
-        gauges = gauge_inputs(store, cases, size)
+        g_in = gauges.inputs(store, cases, size)
+        for path in sorted({str(v) for v in more.values()}):
+            g_in |= gauges.inputs(path, [c for c, v in more.items() if str(v) == path], size)
+        first = {c: first_part(len(d.x), fraction, window) for c, d in data.items()}
         for fold in folds:
             val_fold = validation_fold(fold, folds)
-            tr = [w for c, w in whole.items() if fold_of(c) in pretraining_folds(fold, folds)]
-            va = [w for c, w in whole.items() if fold_of(c) == val_fold]
+            train = [c for c in cases if fold_of(c) in pretraining_folds(fold, folds)] + list(more)
+            val = [c for c in cases if fold_of(c) == val_fold]
+            base, chosen = {}, {}
+            if target == "residual":  # per packing: the gauge chosen on the fold's training hoppers
+                for pk in PACKINGS:
+                    tr_pk = [c for c in train if packing_of(c) == pk]
+                    if tr_pk:
+                        chosen[pk] = gauges.chosen(g_in, nrrp, tr_pk, first)
+                        base |= gauges.cross_fitted(chosen[pk], g_in, nrrp, tr_pk)
+                        base |= {c: gauges.readings(c, tr_pk, g_in, nrrp, 0)[chosen[pk]] for c in val if packing_of(c) == pk}
+            fold_train[fold] = (train, chosen)
+            tr = [_nrrp_windows(data[c], window, stride, base.get(c)) for c in train if len(data[c].x) >= window]
+            va = [_nrrp_windows(data[c], window, stride, base.get(c)) for c in val if len(data[c].x) >= window]
             xt, yt = np.concatenate([a for a, _ in tr]), np.concatenate([b for _, b in tr])
             xv, yv = np.concatenate([a for a, _ in va]), np.concatenate([b for _, b in va])
-            say(f"- fold {fold}: pretraining on {len(xt)} windows of the other folds' whole discharges "
-                f"(validation: fold {val_fold}, {len(xv)} windows)")
+            say(f"- fold {fold}: pretraining on {len(xt)} windows of {len(train)} hoppers' whole discharges"
+                + (f" ({len(more)} of them extra)" if more else "") + f" (validation: fold {val_fold}, {len(xv)} windows)"
+                + (f"; learning the residual on the gauge chosen per packing: {chosen}" if chosen else ""))
             torch.manual_seed(seed)
             model = cnn.CNNLSTM(in_channels=xt.shape[2]).to(dev)
             t0 = time.perf_counter()
             scaling = training.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
-                                 checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=EpochProgress(say))
+                                   checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=EpochProgress(say))
             pretrained[fold] = (model, scaling, time.perf_counter() - t0)
     for case in cases:
         f = data[case]
@@ -224,41 +276,48 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         if len(f.x) < k + window:
             say(f"  {case}: {len(f.x)} frames, too few for windows of {window}; skipped")
             continue
-        xw, yw = _nrrp_windows(f.take(slice(None, k)), window)
-        n_val = max(1, len(xw) // 5)
         row = {"frames": int(len(f.x)), "trained_on": int(k)}
+        base = None
+        if protocol == "pretrained":
+            train, chosen = fold_train[fold_of(case)]
+            same = [c for c in train if packing_of(c) == packing_of(case)]
+            if packing_of(case) in chosen:
+                row["gauge"] = chosen[packing_of(case)]
+                base = gauges.readings(case, same, g_in, nrrp, 0)[row["gauge"]]
+        xw, yw = _nrrp_windows(f.take(slice(None, k)), window, base=None if base is None else base[:k])
+        n_val = max(1, len(xw) // 5)
         t0 = time.perf_counter()
         if protocol == "per-case":
             torch.manual_seed(seed)
             model = cnn.CNNLSTM(in_channels=f.x.shape[1]).to(dev)
             scaling = training.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=epochs, batch=8,
-                                 lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
+                                   lr=lr, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_{case}.pt")
         else:
             base_model, scaling, pre_seconds = pretrained[fold_of(case)]
-            row["zero_shot"] = frame_data.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling))
+            row["zero_shot"] = frame_data.scores(f.nrrp[k:], _read_later(base_model, f, k, window, scaling, base))
             model = copy.deepcopy(base_model)
             training.fit(model, xw[:-n_val], yw[:-n_val], xw[-n_val:], yw[-n_val:], epochs=finetune_epochs, batch=8,
-                       lr=lr / 10, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_finetune_{case}.pt",
-                       scaling=scaling)
+                         lr=lr / 10, seed=seed, clip=LSTM_CLIP, checkpoint=out / f"lstm_finetune_{case}.pt",
+                         scaling=scaling)
             before, after = (_window_mse(m, xw[-n_val:], yw[-n_val:], scaling) for m in (base_model, model))
             row["finetune_kept"] = bool(after < before)
             if not row["finetune_kept"]:
                 model = base_model
             row["pretrain_seconds"] = pre_seconds
         row["train_seconds"] = time.perf_counter() - t0
-        pred = _read_later(model, f, k, window, scaling)
+        pred = _read_later(model, f, k, window, scaling, base)
         truth = f.nrrp[k:]
-        base = baselines.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
-        row |= {"net": frame_data.scores(truth, pred), "baseline": frame_data.scores(truth, base), "time": f.time[k:].tolist(),
-                "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": base.tolist()}
+        constant = baselines.constant_rate_nrrp(f.time, f.nrrp, fraction)[k:]
+        row |= {"net": frame_data.scores(truth, pred), "baseline": frame_data.scores(truth, constant), "time": f.time[k:].tolist(),
+                "nrrp": truth.tolist(), "predicted": pred.tolist(), "baseline_nrrp": constant.tolist()}
         if protocol == "pretrained":
-            row |= gauge_rows(case, gauges, data, folds, k)
+            row |= gauges.scored(case, same, g_in, nrrp, k)
         res["cases"][case] = row
         say(f"  {case}: relative error {row['net']['relative_error']:.3f} "
             + (f"(zero-shot {row['zero_shot']['relative_error']:.3f}) " if "zero_shot" in row else "")
             + f"(constant rate {row['baseline']['relative_error']:.3f}"
-            + "".join(f", {g.replace('_', ' ')} gauge {row[g]['relative_error']:.3f}" for g in GAUGES if g in row) + ")")
-    keys = ("net", "baseline") + (("zero_shot",) + GAUGES if protocol == "pretrained" else ())
+            + "".join(f", {g.replace('_', ' ')} gauge {row[g]['relative_error']:.3f}" for g in gauges.GAUGES if g in row) + ")")
+    keys = ("net", "baseline") + (("zero_shot",) + gauges.GAUGES if protocol == "pretrained" else ())
     res["per_packing"] = {pk: {key: float(np.mean(errs)) for key in keys
                                if (errs := [r[key]["relative_error"] for c, r in res["cases"].items()
                                             if packing_of(c) == pk and key in r])}
@@ -281,47 +340,6 @@ def pretraining_folds(fold: str, folds: list[str]) -> list[str]:
     """The folds a case's network pretrains on (the pretrained protocol): all but the case's own
     and its validation fold."""
     return [f for f in folds if f not in (fold, validation_fold(fold, folds))]
-
-
-GAUGES = ("fill_level", "species")  # the image gauges beside the pretrained network (gauge_rows)
-SPECIES_DEGREE = 2
-
-
-def gauge_inputs(store, cases, size: int, rows: dict | None = None) -> dict:
-    """What the image gauges read of each case's frames: its grey fill fraction at the network's
-    frame size (baselines.fill_fraction) and the fill of each species (baselines.species_fill, from
-    the stored 224 x 224 frames), with the fines' share of its count (from Table 1, or from
-    rows[case], a Table 1-style row, for a hopper not in it)."""
-    st, out = FrameStore(store), {}
-    for c in cases:
-        raw = st.read_case(c)["frames"]
-        grey = frame_data.shrink(raw, size)
-        out[c] = {"fill": baselines.fill_fraction(grey, grey[0]), "species": baselines.species_fill(raw),
-                  "fines_share": baselines.fines_count_share(c, (rows or {}).get(c))}
-    return out
-
-
-def gauge_rows(case: str, gauges: dict, data: dict, folds: list[str], k: int) -> dict:
-    """The case's NRRP from frame k on as two image gauges read it, each calibrated on the whole
-    discharges of cases its network pretrains on — the same cases, the same frames, no learning
-    beyond least squares, per packing: `fill_level`, a cubic of the grey fill fraction
-    (baselines.fill_level_nrrp); `species`, the count from each species' fill, quadratic in each
-    (baselines.species_gauge_nrrp; of degrees 1-3, fitted per packing or over all, the quadratic
-    per packing erred least on the 1 ms frame set). Their scores and readings."""
-    same = [c for c in gauges if packing_of(c) == packing_of(case) and fold_of(c) in pretraining_folds(fold_of(case), folds)]
-    row = gauge_readings(case, same, gauges, {c: data[c].nrrp for c in same + [case]}, k) if same else {}
-    truth = data[case].nrrp[k:]
-    return {name: frame_data.scores(truth, v) for name, v in row.items()} | {f"{name}_nrrp": v.tolist() for name, v in row.items()}
-
-
-def gauge_readings(case: str, train: list[str], gauges: dict, nrrp: dict, k: int) -> dict:
-    """{gauge: the case's NRRP from frame k on} with both gauges calibrated on `train`'s whole
-    discharges (gauges: gauge_inputs; nrrp: each training case's NRRP series)."""
-    design = lambda c: baselines.species_design(gauges[c]["species"], gauges[c]["fines_share"], SPECIES_DEGREE)  # noqa: E731
-    y = np.concatenate([nrrp[c] for c in train])
-    return {"fill_level": baselines.fill_level_nrrp(np.concatenate([gauges[c]["fill"] for c in train]), y,
-                                                 gauges[case]["fill"][k:]),
-            "species": baselines.species_gauge_nrrp(np.concatenate([design(c) for c in train]), y, design(case)[k:])}
 
 
 def _save(path: Path, res: dict):

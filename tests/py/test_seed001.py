@@ -75,6 +75,22 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
                     say=lambda *a: None)
     assert sp["settings"]["inputs"] == "species" and set(sp["per_packing"]) == set(proc["per_packing"])
     assert sp["cases"]["B1-1"]["species"] == proc["cases"]["B1-1"]["species"]  # the gauges do not depend on it
+    # extra hoppers (here subset cases under other names: the plumbing, no DEM) join every fold's
+    # pretraining and the gauges' calibration and are never tested; with the residual target each
+    # case names the gauge chosen for its packing, whose reading the network corrects
+    from pydem.seed001 import gauges
+    from pydem.seed001.store import FrameStore
+    extra = extra_store(tmp_path / "extra.h5", {f"{pk}-x0{i}": f"{pk}-{i}" for pk in ex.PACKINGS for i in (1, 2)})
+    kw = dict(size=32, window=2, epochs=1, fraction=0.4, finetune_epochs=2, say=lambda *a: None)
+    res = ex.process(SUBSET, tmp_path / "r", extra=[extra], extra_per_packing=1, target="residual", **kw)
+    assert res["settings"]["extra_hoppers"] == [f"{pk}-x01" for pk in ex.PACKINGS] and "gauge" not in proc["cases"]["A-1"]
+    assert set(res["cases"]) == set(FrameStore(SUBSET).cases())  # the extra hoppers are never test cases
+    assert all(r["gauge"] in gauges.GAUGES and 0 <= min(r["predicted"]) <= max(r["predicted"]) <= 1
+               for r in res["cases"].values())
+    assert res["cases"]["A-1"]["fill_level_nrrp"] != proc["cases"]["A-1"]["fill_level_nrrp"]  # calibrated on more
+    clash = extra_store(tmp_path / "clash.h5", {"A-1": "A-1"})  # a test case among the training hoppers: refused
+    with pytest.raises(ValueError, match="A-1 is a Table 1 case"):
+        ex.process(SUBSET, tmp_path / "c", extra=[clash], **kw)
 
 
 def test_windows_with_a_stride_start_every_stride_frames():
@@ -108,3 +124,17 @@ def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
                          env={**os.environ, "SEED001_NO_BINDING": "1"})
     assert out.returncode == 0, out.stderr
     assert out.stdout.split()[-1] == "25"
+
+
+def extra_store(path, names: dict):
+    """A store of 'more hoppers' made from subset cases under other names (the plumbing, not the
+    physics: no DEM), each with its Table 1-style row as pydem images hoppers stores it."""
+    from pydem.rigs.table1 import TABLE1
+    from pydem.seed001.store import FrameStore
+    src, dst = FrameStore(SUBSET), FrameStore(path)
+    for new, old in names.items():
+        d = src.read_case(old)
+        row = TABLE1[old]
+        dst.write_case(new, d["frames"], d["time"], d["discharge_time"], d["nrrp"],
+                       {"packing": new.split("-")[0], "row": json.dumps([*row[:9], list(row[9]), row[10]])})
+    return path
