@@ -5,6 +5,7 @@ remaining time as the frame's fill fraction times it; a constant-rate extrapolat
 frame's fill level, and from each species' visible fill."""
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -14,8 +15,13 @@ from .store import species_masks
 
 
 def case_mass_and_size(attrs: dict) -> tuple[float, float, float]:
-    """(total mass kg, mean diameter m, solid density) of a stored Table 1 case from its attributes."""
-    row = TABLE1[attrs["case"]]
+    """(total mass kg, mean diameter m, solid density) of a stored Table 1 case from its attributes,
+    or of a hopper drawn like them from the row stored with it (pydem images hoppers)."""
+    if "row" in attrs:
+        r = json.loads(attrs["row"])
+        row = tuple(r[:9]) + (tuple(r[9]),) + tuple(r[10:])
+    else:
+        row = TABLE1[attrs["case"]]
     phi, dd, rho = row[3], row[9], row[10]
     return rho * solid_volume(row), (phi * dd[0] + (1.0 - phi) * dd[1]) / 1000.0, float(rho)
 

@@ -107,6 +107,13 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
         if name == "compare":
             e.add_argument("--models", nargs="+", help="a subset of alexnet resnet50 vgg16 vgg19")
             e.add_argument("--time-budget", type=float, help="s of training per network after which no epoch starts")
+        if name != "compare":
+            e.add_argument("--extra", nargs="+", default=[], metavar="STORE",
+                           help="frame stores of more hoppers (pydem images hoppers): training (process: pretraining "
+                                "and the gauges' calibration; point-to-point: the leave-cases-out training) only, never "
+                                "tested")
+            e.add_argument("--extra-per-packing", type=int, metavar="K",
+                           help="the first K extra hoppers of each packing only (the curve of error against hoppers)")
         if name == "process":
             e.add_argument("--protocol", choices=("pretrained", "per-case"), default="pretrained",
                            help="pretrained: on other cases' whole discharges, fine-tuned on the case's first 20 %% "
@@ -115,11 +122,6 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
                            help="what the network sees of a frame: grey (seed 001's) or species (fine and coarse "
                                 "spheres as two channels, read from the grey levels)")
             e.add_argument("--stride", type=int, default=4, help="pretraining windows every N frames (default 4)")
-            e.add_argument("--extra", nargs="+", default=[], metavar="STORE",
-                           help="frame stores of more hoppers (pydem images hoppers): pretraining and gauge "
-                                "calibration only, never tested")
-            e.add_argument("--extra-per-packing", type=int, metavar="K",
-                           help="the first K extra hoppers of each packing only (the curve of error against hoppers)")
             e.add_argument("--target", choices=("nrrp", "residual"), default="nrrp",
                            help="what the network learns: the NRRP (default), or its residual on the image gauge "
                                 "chosen per packing from the training hoppers")
@@ -162,8 +164,9 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
             kw |= {k: v for k, v in (("models", args.models), ("time_budget", args.time_budget)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
-            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride, "extra": args.extra,
-                   "extra_per_packing": args.extra_per_packing, "target": args.target}
+            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride, "target": args.target}
+        if args.cmd != "compare":
+            kw |= {"extra": args.extra, "extra_per_packing": args.extra_per_packing}
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]
         try:
             run(args.store, args.out, size=args.size, seed=args.seed, **kw)

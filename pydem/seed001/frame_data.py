@@ -34,6 +34,12 @@ class Frames:
                       self.discharge, self.attrs)
 
 
+def concat(parts: list[Frames]) -> Frames:
+    """The frames of several loads as one (each case's frames stay in time order)."""
+    return Frames(*(np.concatenate([getattr(f, k) for f in parts]) for k in ("x", "case", "time", "remaining", "nrrp")),
+                  {c: v for f in parts for c, v in f.discharge.items()}, {c: v for f in parts for c, v in f.attrs.items()})
+
+
 def shrink(frames: np.ndarray, size: int) -> np.ndarray:
     """uint8 (n, H, W) -> float32 (n, 1, size, size) in [0, 1], area-averaged."""
     x = torch.from_numpy(np.asarray(frames, np.float32) / 255.0)[:, None]

@@ -88,6 +88,11 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert all(r["gauge"] in gauges.GAUGES and 0 <= min(r["predicted"]) <= max(r["predicted"]) <= 1
                for r in res["cases"].values())
     assert res["cases"]["A-1"]["fill_level_nrrp"] != proc["cases"]["A-1"]["fill_level_nrrp"]  # calibrated on more
+    # AlexNet-FC: the extra hoppers train the leave-cases-out split only; the random split stays Table 1's
+    more = ex.point_to_point(SUBSET, tmp_path / "pe", size=64, every=4, epochs=1, extra=[extra], say=lambda *a: None)
+    assert more["settings"]["extra_hoppers"] == sorted(f"{pk}-x0{i}" for pk in ex.PACKINGS for i in (1, 2))
+    assert set(more["splits"]["leave_cases_out"]["test"]["case"]) == set(p2p["settings"]["test_cases"])
+    assert more["settings"]["frames"] + more["settings"]["extra_frames"] > more["settings"]["frames"]
     clash = extra_store(tmp_path / "clash.h5", {"A-1": "A-1"})  # a test case among the training hoppers: refused
     with pytest.raises(ValueError, match="A-1 is a Table 1 case"):
         ex.process(SUBSET, tmp_path / "c", extra=[clash], **kw)
