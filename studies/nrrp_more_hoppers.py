@@ -10,6 +10,9 @@ full size, a frame every 1 ms, one resumable store per packing):
     .venv/bin/pydem images hoppers --packing B1 --hoppers 12 --store data/seed001/extra_B1.h5
     .venv/bin/python studies/nrrp_more_hoppers.py evaluate --packing B1 --store data/seed001/extra_B1.h5 \\
         --table1 data/seed001/frames_full.h5 --out studies/results/seed001/nrrp_more_hoppers_B1.json
+    .venv/bin/python studies/nrrp_more_hoppers.py curve --table1 data/seed001/frames_full.h5 \\
+        --extra 'data/seed001/extra_{packing}.h5' --counts 0 3 6 12 24 --networks build/lstm_k0 build/lstm_k12 \\
+        --out studies/results/seed001/hoppers_curve.json --figure docs/seed001/hoppers_curve.png
 """
 from __future__ import annotations
 
@@ -55,6 +58,101 @@ def evaluate(args) -> int:
     return 0
 
 
+TARGET = 0.08  # seed 001's average relative error of the NRRP
+
+
+def curve(args) -> int:
+    """The error of the NRRP readers against the hoppers used per packing: the chosen gauge (and
+    each gauge) calibrated on the three Table 1 hoppers of the case's pretraining folds plus the
+    first K extra hoppers, for each K of --counts; the networks' points from `process` runs made
+    with --extra-per-packing K (--networks). A power law err = a n^b through each reader's points
+    (n = hoppers used) says where it would reach seed 001's 0.08 — an extrapolation, marked so."""
+    from pydem.seed001 import experiments as ex
+    from pydem.seed001 import frame_data, gauges
+    from pydem.seed001.store import FrameStore
+    t1 = FrameStore(args.table1)
+    out = {"counts": args.counts, "size": args.size, "target": TARGET, "packings": {}}
+    for pk in args.packings:
+        table1 = [c for c in t1.cases() if ex.packing_of(c) == pk]
+        path = args.extra.replace("{packing}", pk)
+        extra = sorted(FrameStore(path).cases())
+        g_in = gauges.inputs(args.table1, table1, args.size) | gauges.inputs(path, extra, args.size)
+        nrrp = {c: t1.read_case(c)["nrrp"] for c in table1} | {c: FrameStore(path).read_case(c)["nrrp"] for c in extra}
+        first = {c: ex.first_part(len(v), 0.2, args.window) for c, v in nrrp.items()}
+        folds = sorted({ex.fold_of(c) for c in table1})
+        rows = {}
+        for k in [k for k in args.counts if k <= len(extra)]:
+            errs = {g: [] for g in gauges.GAUGES + ("chosen",)}
+            for case in table1:
+                train = [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)] + extra[:k]
+                got = {g: frame_data.scores(nrrp[case][first[case]:], v)["relative_error"]
+                       for g, v in gauges.readings(case, train, g_in, nrrp, first[case]).items()}
+                got["chosen"] = got[gauges.chosen(g_in, nrrp, train, first)]
+                for g, e in got.items():
+                    errs[g].append(e)
+            rows[k] = {"hoppers": len(folds) - 2 + k, **{g: float(np.mean(v)) for g, v in errs.items()}}
+            print(f"{pk}, {rows[k]['hoppers']} hoppers: " + ", ".join(f"{g} {rows[k][g]:.3f}" for g in errs), flush=True)
+        out["packings"][pk] = {"gauges": rows, "extra_available": len(extra)}
+    for d in args.networks or []:
+        run = json.loads((Path(d) / "process.json").read_text())
+        per = {pk: sum(ex.packing_of(c) == pk for c in run["settings"].get("extra_hoppers", [])) for pk in args.packings}
+        for pk in args.packings:
+            if pk in run["per_packing"]:
+                out["packings"][pk].setdefault("network", {})[str(per[pk])] = {
+                    "hoppers": 3 + per[pk], "net": run["per_packing"][pk]["net"], "run": str(d),
+                    "target": run["settings"].get("target", "nrrp"), "inputs": run["settings"].get("inputs")}
+    for pk, v in out["packings"].items():
+        v["reach"] = {name: reach([(r["hoppers"], r[key]) for r in pts.values()])
+                      for name, pts, key in (("chosen gauge", v["gauges"], "chosen"),
+                                             ("network", v.get("network", {}), "net")) if len(pts) >= 2}
+    Path(args.out).write_text(json.dumps(out, indent=1))
+    if args.figure:
+        curve_figure(out, args.figure)
+    return 0
+
+
+def reach(points: list[tuple[int, float]]) -> dict:
+    """err = a n^b fitted through (n, err) by least squares in logs; the n where it would reach
+    TARGET (None when the error does not fall with n)."""
+    points = [(n, e) for n, e in points if np.isfinite(e) and e > 0]
+    if len(points) < 2:
+        return {"exponent": None, "a": None, "hoppers_for_target": None, "reached": False, "extrapolated": False}
+    n, e = (np.array(v, float) for v in zip(*points))
+    b, log_a = np.polyfit(np.log(n), np.log(e), 1)
+    needed = float(np.exp((np.log(TARGET) - log_a) / b)) if b < 0 else None
+    return {"exponent": float(b), "a": float(np.exp(log_a)), "hoppers_for_target": needed,
+            "reached": bool(np.min(e) <= TARGET), "extrapolated": bool(needed is not None and needed > n.max())}
+
+
+def curve_figure(res: dict, path: str):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(res["packings"]), figsize=(3.2 * len(res["packings"]), 3.2), sharey=True, squeeze=False)
+    for ax, (pk, v) in zip(axes[0], res["packings"].items()):
+        for name, pts, key, style in (("chosen gauge", v["gauges"], "chosen", "o-"), ("network", v.get("network", {}), "net", "s-")):
+            if not pts:
+                continue
+            n = sorted((r["hoppers"], r[key]) for r in pts.values())
+            ax.plot(*zip(*n), style, label=name)
+            fit = v["reach"].get(name)
+            if fit and fit["hoppers_for_target"]:
+                xs = np.geomspace(n[0][0], max(n[-1][0], min(fit["hoppers_for_target"], 1000)), 50)
+                ax.plot(xs, fit["a"] * xs ** fit["exponent"], ":", color=ax.lines[-1].get_color())
+        ax.axhline(res["target"], color="k", lw=0.8, ls="--")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlim(2.5, 400)
+        ax.set_xticks([3, 6, 12, 24, 48, 96, 192], labels=["3", "6", "12", "24", "48", "96", "192"])
+        ax.minorticks_off()
+        ax.set_title(pk)
+        ax.set_xlabel("hoppers used per packing")
+    axes[0][0].set_ylabel("mean relative error of the NRRP")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -64,8 +162,20 @@ def main() -> int:
     e.add_argument("--table1", required=True, help="the frame store of the 25 Table 1 cases")
     e.add_argument("--size", type=int, default=224, help="frame side of the fill-level gauge")
     e.add_argument("--out", required=True)
+    c = sub.add_parser("curve", help="error against hoppers used, per packing, with the extrapolation to 0.08")
+    c.add_argument("--table1", required=True, help="the frame store of the 25 Table 1 cases")
+    c.add_argument("--extra", required=True, help="the extra hoppers' store, {packing} in its name "
+                                                   "(e.g. data/seed001/extra_{packing}.h5)")
+    c.add_argument("--packings", nargs="+", default=["A", "B1", "B2", "B3", "B4"])
+    c.add_argument("--counts", nargs="+", type=int, default=[0, 3, 6, 12, 24], help="extra hoppers per packing")
+    c.add_argument("--size", type=int, default=224, help="frame side of the fill-level gauge")
+    c.add_argument("--window", type=int, default=8, help="the process runs' window: the readers start after "
+                                                         "max(window + 2, 20 %% of the frames)")
+    c.add_argument("--networks", nargs="*", help="process output folders made with --extra-per-packing K")
+    c.add_argument("--out", required=True)
+    c.add_argument("--figure")
     args = ap.parse_args()
-    return evaluate(args)
+    return evaluate(args) if args.cmd == "evaluate" else curve(args)
 
 
 if __name__ == "__main__":
