@@ -17,40 +17,29 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
-import numpy as np
 
 from ..cli_inputs import seed_value
 from ..rigs.table1 import TABLE1
 from .gra import PARAMETERS, gra_tables, parameter_row
 from .store import FrameStore
 
-def run_frames(store_path: str, cases: list[str], frame_interval: float, threads: int, say=print):
-    from ..rigs import RIGS, load  # the rigs need the compiled binding; the other commands run without it
+def run_frames(store_path: str, cases: list[str], frame_interval: float, workers: int, say=print):
+    """The Table 1 cases the store lacks, `workers` at a time (one thread each; pydem.seed001.hoppers
+    runs them); a case that fails is kept in the store with its reason and reported, and run again
+    on the next call."""
+    from .hoppers import run_into_store
     store = FrameStore(store_path)
     done = set(store.cases())
-    cls, cfg_cls = RIGS["hopper"]
     for case in cases:
         if case in done:
             say(f"  {case}: in the store already")
-            continue
-        cfg = load(cfg_cls, "default", None, [f"case={case}", f"frame_interval={frame_interval}", f"num_threads={threads}"])
-        t0 = time.perf_counter()
-        try:
-            res = cls(cfg).run(seed=0, images=True)
-        except Exception as exc:  # one case that fails (a runaway overlap, a jam) does not stop the others
-            say(f"  {case}: the run failed ({exc}); not stored")
-            continue
-        t_dis = res.metrics["discharge_time"].value
-        if not np.isfinite(t_dis):
-            say(f"  {case}: did not empty ({res.metrics['discharge_time'].note}); not stored")
-            continue
-        store.write_case(case, res.images, res.series["frame_time"], t_dis, res.series["frame_nrrp"],
-                         {"packing": case.split("-")[0], **{f"param_{k}": v for k, v in parameter_row(case).items()},
-                          "particles": res.info["particles"], "frame_interval": frame_interval,
-                          "dem_seconds": time.perf_counter() - t0})
-        say(f"  {case}: {len(res.images)} frames, discharge time {t_dis:.3f} s, {time.perf_counter() - t0:.0f} s")
+    todo = [c for c in cases if c not in done]
+    attrs = {c: {"packing": c.split("-")[0], **{f"param_{k}": v for k, v in parameter_row(c).items()},
+                 "frame_interval": frame_interval} for c in todo}
+    failed: dict = {}
+    run_into_store(store, {c: (TABLE1[c], c.split("-")[0]) for c in todo}, frame_interval, workers, attrs, failed, say)
+    return failed
 
 
 def write_subset(full: str, out: str, every: int):
@@ -70,7 +59,7 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
     f.add_argument("--store", required=True)
     f.add_argument("--cases", nargs="+", default=list(TABLE1), choices=list(TABLE1))
     f.add_argument("--frame-interval", type=float, default=0.02, help="s between frames (default 0.02)")
-    f.add_argument("--threads", type=int, default=1)
+    f.add_argument("--workers", type=int, default=1, help="cases run side by side, one thread each (default 1)")
     h = sub.add_parser("hoppers", help="more hoppers of a packing, drawn like Table 1's, into a frame store of their "
                                        "own: pretraining and calibration data, never test cases (resumable)")
     h.add_argument("--packing", required=True, choices=("A", "B1", "B2", "B3", "B4"))
@@ -145,8 +134,8 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
         print(f"{args.store}: {len(got['stored'])} of {args.hoppers} hoppers stored, {len(got['failed'])} failed")
         return 0
     if args.cmd == "frames":
-        run_frames(args.store, args.cases, args.frame_interval, args.threads)
-        return 0
+        failed = run_frames(args.store, args.cases, args.frame_interval, args.workers, say=lambda m: print(m, flush=True))
+        return 1 if failed else 0
     if args.cmd == "subset":
         write_subset(args.store, args.out, args.every)
         return 0

@@ -53,7 +53,6 @@ def run_hoppers(store_path, packing: str, hoppers: int, seed: int = 1, frame_int
     """Runs the hoppers the store lacks; returns {"stored": [...], "failed": {name: reason}}.
     A store drawn with another seed, volume scale or frame interval is refused (its names would
     mean other hoppers)."""
-    from ..campaign.workers import run_local
     if packing not in PACKINGS:
         raise ValueError(f"packing: one of {', '.join(PACKINGS)}, got {packing!r}")
     if hoppers < 1 or not np.isfinite(frame_interval) or frame_interval <= 0 or not 0 < volume_scale <= 1:
@@ -76,27 +75,39 @@ def run_hoppers(store_path, packing: str, hoppers: int, seed: int = 1, frame_int
     for name, reason in failed.items():
         if name not in todo:
             say(f"  {name}: failed before: {reason}")
+    run_into_store(store, {k: (rows[k], packing) for k in todo}, frame_interval, workers,
+                   {k: settings | {"row": json.dumps(rows[k])} for k in todo}, failed, say)
+    return {"stored": sorted(set(store.cases()) & set(rows)), "failed": failed}
+
+
+def run_into_store(store: FrameStore, jobs: dict, frame_interval: float, workers: int, attrs: dict, failed: dict,
+                   say=print):
+    """Runs each job {name: (Table 1-style row, packing)} in a worker process, `workers` at a time,
+    and writes each into the store as it ends, with attrs[name] and its DEM time: a case whole, or
+    a failure with its reason (also into `failed`), a progress line each."""
+    from ..campaign.workers import run_local
+    names = list(jobs)
     t0, ended = time.perf_counter(), 0
 
     def on_result(i: int, res: dict):
         nonlocal ended
-        name = todo[i]
+        name = names[i]
         ended += 1
-        attrs = settings | {"row": json.dumps(rows[name]), "dem_seconds": float(res.get("wall") or 0.0)}
+        a = attrs.get(name, {}) | {"dem_seconds": float(res.get("wall") or 0.0)}
         if "error" in res:
-            store.write_failure(name, res["error"], attrs)
+            store.write_failure(name, res["error"], a)
             failed[name] = res["error"]
             what = f"failed: {res['error']}"
         else:
             store.write_case(name, res["frames"], res["time"], res["discharge_time"], res["nrrp"],
-                             attrs | {"particles": res["particles"]})
+                             a | {"particles": res["particles"]})
             failed.pop(name, None)
-            what = f"N {rows[name][0]}, {len(res['frames'])} frames, discharge {res['discharge_time']:.3f} s"
-        left = (time.perf_counter() - t0) / ended * (len(todo) - ended)
-        say(f"  {name}: {what}, {res.get('wall') or 0:.0f} s; {ended}/{len(todo)} done, "
-            f"{sum(k in failed for k in todo)} failed, ~{left / 60:.0f} min left")
+            what = f"N {jobs[name][0][0]}, {len(res['frames'])} frames, discharge {res['discharge_time']:.3f} s"
+        left = (time.perf_counter() - t0) / ended * (len(names) - ended)
+        say(f"  {name}: {what}, {res.get('wall') or 0:.0f} s; {ended}/{len(names)} done, "
+            f"{sum(k in failed for k in names)} failed, ~{left / 60:.0f} min left")
 
-    if todo:
-        run_local({i: (name, rows[name], packing, frame_interval) for i, name in enumerate(todo)}, run_one,
-                  max(1, min(workers, len(todo))), on_result, say)
-    return {"stored": sorted(set(store.cases()) & set(rows)), "failed": failed}
+    if names:
+        run_local({i: (name, list(jobs[name][0][:9]) + [list(jobs[name][0][9]), jobs[name][0][10]], jobs[name][1],
+                       frame_interval) for i, name in enumerate(names)}, run_one, max(1, min(workers, len(names))),
+                  on_result, say)

@@ -39,3 +39,14 @@ def test_more_hoppers_are_stored_resumed_and_their_failures_kept(tmp_path):
     run_hoppers(shallow, "A", 1, seed=17, say=said.append, **(QUICK | {"volume_scale": 0.05}))
     assert "1 failed before" in said[0] and any("A-x01: failed before: the run failed" in m for m in said)
     assert FrameStore(shallow).cases() == []  # a failure is no case
+
+
+def test_the_table1_frame_set_runs_in_workers_and_resumes(tmp_path):
+    """`pydem images frames` runs the Table 1 cases the store lacks side by side (the same runner
+    as the extra hoppers), each stored with its Table 1 parameters; a rerun skips them."""
+    from pydem.seed001.cli import main
+    store = tmp_path / "f.h5"
+    assert main(["frames", "--store", str(store), "--cases", "A-1", "--frame-interval", "0.02", "--workers", "2"]) == 0
+    d = FrameStore(store).read_case("A-1")
+    assert d["particles"] == 620 and d["param_particles"] == 620 and d["packing"] == "A" and d["nrrp"][0] == 1.0
+    assert main(["frames", "--store", str(store), "--cases", "A-1", "--frame-interval", "0.02"]) == 0
