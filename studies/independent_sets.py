@@ -167,6 +167,8 @@ def diagnose(args):
     if Path(args.out).exists():  # resumable: the sets diagnosed already are kept
         out["sets"] = [s for s in json.loads(Path(args.out).read_text())["sets"] if "error" not in s]
     done = {s["set"] for s in out["sets"]}
+    if args.sets:  # these sets only (e.g. those whose refinement runs are done, scored by another checkout)
+        rows = [r for r in rows if r["set"] in args.sets]
     with tempfile.TemporaryDirectory() as tmp:
         for row in rows:
             if row["set"] in done:
@@ -296,6 +298,7 @@ def main() -> int:
     dg.add_argument("--runs", default="build/refine_runs", help="where each set's output and refinement runs are kept")
     dg.add_argument("--workers", type=int, default=2, help="worker processes of each set's refinement runs")
     dg.add_argument("--refine-design", default="greedy", choices=("greedy", "fixed"), help="pydem diagnose --refine-design")
+    dg.add_argument("--sets", nargs="+", type=int, help="these sets only")
     sm = sub.add_parser("summary")
     sm.add_argument("results", nargs="+")
     sm.add_argument("--markdown", help="a refined validation's per-set table, as Markdown, into this file")

@@ -14,7 +14,15 @@ so near the runs the prediction is as good as their seed scatter allows and far 
 the net with its error, unchanged. The row's net-error term becomes the local error scaled by
 sqrt(v / e^2) (at least FLOOR of it: the kernel's length is assumed, not fitted). Leave-one-out
 residuals come in closed form, alpha_i / (K^-1)_ii: the error of the corrected prediction at a
-run that it did not see, against that run (seed scatter included)."""
+run that it did not see, against that run (seed scatter included).
+
+The prior is checked against the runs: under it the residuals' Mahalanobis norm r' K^-1 r is
+chi^2 with n degrees of freedom. Where the net is worse near the material than its global error
+model says, the norm is larger, and every variance of the process is scaled by
+c^2 = (PRIOR_DOF + r' K^-1 r) / (PRIOR_DOF + n), the model's own error counted as PRIOR_DOF
+degrees of freedom beside the runs' (the estimate of an overall covariance scale, tempered).
+The correction's mean does not change; its error does, by c (error_scale), never below 1: the
+runs may show the net worse than its error model but are too few to show it better."""
 from __future__ import annotations
 
 import numpy as np
@@ -23,6 +31,7 @@ from scipy import linalg
 from .fit import NET_ERROR_LENGTH
 
 FLOOR = 0.05  # the corrected net error is at least this fraction of the net's own there
+PRIOR_DOF = 4  # the net's error model counts as this many degrees of freedom beside the runs' residuals
 
 
 def correlation(net, a, b) -> np.ndarray:
@@ -69,6 +78,8 @@ class CorrectedNet:
         self.alpha = linalg.cho_solve(self._chol, self.residuals)
         kinv_diag = np.diag(linalg.cho_solve(self._chol, np.eye(len(self.y))))
         self.loo_residuals = self.alpha / kinv_diag  # y_i - (corrected prediction without run i)
+        self.mahalanobis = float(self.residuals @ self.alpha)  # chi^2 with len(y) dof under the prior
+        self.error_scale = float(np.sqrt(max(1.0, (PRIOR_DOF + self.mahalanobis) / (PRIOR_DOF + len(self.y)))))
 
     def __getattr__(self, name):  # the net's inputs, box, seed scatter, correlations
         return getattr(self.net, name)
@@ -105,7 +116,8 @@ class CorrectedNet:
         else:
             m = len(np.atleast_2d(x))
             seed, err = np.full(m, self.net.seed_sd), np.full(m, self.net.net_error)
-        return seed * self.seed_scale[0], err * np.sqrt(np.maximum(self.variance_fraction(x), FLOOR ** 2))
+        return (seed * self.seed_scale[0],
+                err * self.error_scale * np.sqrt(np.maximum(self.variance_fraction(x), FLOOR ** 2)))
 
     @property
     def seed_sd(self) -> float:

@@ -331,7 +331,8 @@ def summary(first, second, entries: list[dict], nets: dict, obs: list[Observatio
         if isinstance(net, CorrectedNet):
             per_q[q.key] = {"runs": len(net.y), "net_rmse": net.raw_rmse(), "corrected_loo_rmse": net.loo_rmse(),
                             "seed_sd": float(np.sqrt(np.mean(net.noise))), "seed_scale": net.seed_scale[0],
-                            "repeat_dof": net.seed_scale[1]}
+                            "repeat_dof": net.seed_scale[1], "error_scale": net.error_scale,
+                            "mahalanobis": net.mahalanobis}
     rows = [{"label": o.label, "uncertainty": o.uncertainty if o.uncertainty_given else None,
              "net_error_first": float(a), "net_error_second": float(b)}
             for o, a, b in zip(obs, first.base_model.net_errors, second.base_model.net_errors)]

@@ -359,11 +359,13 @@ def refinement_section(r: dict) -> tuple[str, str, str]:
              _g(x["net_error_first"]), _g(x["net_error_second"])] for x in r["rows"]]
     md2, h2 = page.table(rows, ["measurement", "its uncertainty", "surrogate error, first pass", "after refinement"])
     rows = [[q, v["runs"], _g(v["net_rmse"]), _g(v["corrected_loo_rmse"]), _g(v.get("seed_sd")),
-             f"x{v['seed_scale']:.2f} ({v['repeat_dof']} dof)" if v.get("repeat_dof") else "-"]
+             f"x{v['seed_scale']:.2f} ({v['repeat_dof']} dof)" if v.get("repeat_dof") else "-",
+             f"x{v['error_scale']:.2f}" if "error_scale" in v else "-"]
             for q, v in r["quantities"].items()]
     md3, h3 = page.table(rows, ["quantity", "runs", "global net's RMSE at the runs", "corrected, leave one out",
                                 "one run's seed scatter there (the floor of both)",
-                                "seed scatter from the repeats, on the nets'"])
+                                "seed scatter from the repeats, on the nets'",
+                                "net error near the material, from the runs' residuals, on the error model's"])
     failed = "; ".join(f"run {f['index']} ({f['rig']}): {f['error']}" for f in r["failed"]) or "none"
     text = (f"{r['runs']} refinement runs ({r['cpu_seconds']:.0f} s of CPU; failed: {failed}), kept in {r['folder']}. "
             f"The second pass uses the surrogates corrected by them (docs/diagnosis.md §8); the rest of this report is "

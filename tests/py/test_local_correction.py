@@ -86,3 +86,23 @@ def test_repeated_runs_measure_the_seed_scatter_with_the_nets_as_prior():
     assert local_seed_scale(SmoothNet(), x[:1], y[:1], ["a"]) == (1.0, 0)
     c = CorrectedNet(SmoothNet(), x, y, seed_scale=(scale, dof))
     assert c.noise == pytest.approx(np.full(6, (0.01 * scale) ** 2)) and c.errors_at(x[:1])[0][0] == pytest.approx(0.01 * scale)
+
+
+def test_residuals_larger_than_the_error_model_scale_the_error_up():
+    """Under the prior the residuals' Mahalanobis norm r' K^-1 r is chi^2 with n dof. Residuals three
+    times as large have nine times the norm, and the corrected error grows by
+    c = sqrt((4 + r' K^-1 r) / (4 + n)) everywhere (the mean's correction is as before); residuals the
+    model expects leave it at 1: the runs never make the error smaller than the model says."""
+    from pydem.calibration.local_correction import PRIOR_DOF
+    x, y = runs(n=12)
+    net = SmoothNet()
+    c1 = CorrectedNet(net, x, y)
+    assert c1.error_scale == 1.0 and c1.mahalanobis < len(y)
+    big = CorrectedNet(net, x, net(x) + 3.0 * (y - net(x)))
+    assert big.mahalanobis == pytest.approx(9.0 * c1.mahalanobis, rel=1e-12)
+    c = np.sqrt((PRIOR_DOF + big.mahalanobis) / (PRIOR_DOF + len(y)))
+    assert c > 1.5 and big.error_scale == pytest.approx(c, rel=1e-12)
+    p = np.array([[0.5, 0.5], [40.0, -40.0]])
+    assert big.errors_at(p)[1] == pytest.approx(c * c1.errors_at(p)[1], rel=1e-12)
+    assert big.errors_at(p)[1][1] == pytest.approx(c * net.net_error, rel=1e-9)  # far away too: the region's model
+    assert big.correction(p) == pytest.approx(3.0 * c1.correction(p), rel=1e-12)  # the mean: unchanged by c
