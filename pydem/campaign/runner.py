@@ -21,8 +21,10 @@ from .store import DONE, FAILED, STATUS_NAMES, CampaignStore, StoreError, physic
 
 def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
     """One rig run: parameters in, metrics out ({name: (value, uncertainty, unit)}), or the
-    error message. Pure (depends on its arguments only); runs in a worker process."""
-    t0 = time.perf_counter()
+    error message, with its wall and CPU seconds (the worker process's: a run is one thread, so its
+    CPU time does not count other work on the machine). Pure (depends on its arguments only); runs
+    in a worker process."""
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         spec = CampaignSpec.from_json(spec_json)
         cfg = spec.config(values)
@@ -31,11 +33,12 @@ def simulate(spec_json: str, values: dict[str, float], seed: int) -> dict:
         result = RIGS[spec.rig][0](cfg).run(seed=seed)
         metrics = {k: (float(m.value), float(m.uncertainty), m.unit) for k, m in result.metrics.items()
                    if isinstance(m.value, (int, float))}
-        return {"metrics": metrics, "wall": time.perf_counter() - t0}
+        return {"metrics": metrics, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
     except Exception as exc:  # recorded in the store; the campaign goes on
         last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
         where = f" (at {Path(last.filename).name}:{last.lineno})" if last else ""
-        return {"error": f"{type(exc).__name__}: {exc}{where}", "wall": time.perf_counter() - t0}
+        return {"error": f"{type(exc).__name__}: {exc}{where}", "wall": time.perf_counter() - t0,
+                "cpu": time.process_time() - c0}
 
 
 def sample_seed(campaign_seed: int, index: int) -> int:
