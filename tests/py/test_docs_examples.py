@@ -77,7 +77,8 @@ def test_documented_command(argv, tmp_path):
             from pydem.campaign import Campaign
             Campaign.open(ROOT / store)
         if cmd in ("diagnose", "calibrate") and not in_the_tour(argv):  # the tour's own test runs those
-            r = subprocess.run([sys.executable, "-m", "pydem", *argv[:-2], "--out", str(tmp_path / "d")], cwd=ROOT,
+            keep = [a for i, a in enumerate(argv) if a != "--out" and (i == 0 or argv[i - 1] != "--out")]
+            r = subprocess.run([sys.executable, "-m", "pydem", *keep, "--out", str(tmp_path / "d")], cwd=ROOT,
                                capture_output=True, text=True, timeout=300)
             assert r.returncode == 0, r.stderr
 
