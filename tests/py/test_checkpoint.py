@@ -9,9 +9,13 @@ import pytest
 from pydem.rigs import RIGS, load
 
 
+# the tiny ring shear's shearing shortened (its phases as they are): the splits, not the physics, are checked
+SHORT = {"ring-shear": ["first_preshear_displacement=3e-3", "preshear_displacement=2e-3", "shear_displacement=1.5e-3"]}
+
+
 def tiny(rig, *extra):
     cls, cfg_cls = RIGS[rig]
-    return cls(load(cfg_cls, "tiny", None, ["num_threads=1", *extra]))
+    return cls(load(cfg_cls, "tiny", None, ["num_threads=1", *SHORT.get(rig, []), *extra]))
 
 
 def assert_same_run(res, whole):
