@@ -13,7 +13,7 @@ import sys
 
 def add_parser(sub):
     p = sub.add_parser("images", add_help=False,
-                       help="seed 001's hopper images: frames, gra, compare, point-to-point, process, report")
+                       help="seed 001's hopper images: frames, hoppers, gra, compare, point-to-point, process, report")
     p.add_argument("args", nargs=argparse.REMAINDER, help="a subcommand and its options (pydem images --help)")
     p.set_defaults(func=lambda args: forward(args.args))  # reached only when a caller parses argv itself
 
