@@ -64,6 +64,17 @@ def draw_like_table1(packing: str, hoppers: int, seed: int, volume_scale: float 
     return out
 
 
+def row_as_json(row: tuple) -> list:
+    """A Table 1-style row as JSON holds it (the sizes pair as a list): how a hopper drawn like
+    Table 1's is stored with its frames (pydem images hoppers)."""
+    return [*row[:9], list(row[9]), row[10]]
+
+
+def row_from_json(r: list) -> tuple:
+    """row_as_json's inverse."""
+    return tuple(r[:9]) + (tuple(r[9]),) + tuple(r[10:])
+
+
 def solid_volume(row: tuple) -> float:
     """m^3 of spheres in a Table 1-style row."""
     n, phi, dd = row[0], row[3], row[9]

@@ -10,18 +10,14 @@ import math
 
 import numpy as np
 
-from ..rigs.table1 import TABLE1, solid_volume, species_counts
+from ..rigs.table1 import TABLE1, row_from_json, solid_volume, species_counts
 from .store import species_masks
 
 
 def case_mass_and_size(attrs: dict) -> tuple[float, float, float]:
     """(total mass kg, mean diameter m, solid density) of a stored Table 1 case from its attributes,
     or of a hopper drawn like them from the row stored with it (pydem images hoppers)."""
-    if "row" in attrs:
-        r = json.loads(attrs["row"])
-        row = tuple(r[:9]) + (tuple(r[9]),) + tuple(r[10:])
-    else:
-        row = TABLE1[attrs["case"]]
+    row = row_from_json(json.loads(attrs["row"])) if "row" in attrs else TABLE1[attrs["case"]]
     phi, dd, rho = row[3], row[9], row[10]
     return rho * solid_volume(row), (phi * dd[0] + (1.0 - phi) * dd[1]) / 1000.0, float(rho)
 

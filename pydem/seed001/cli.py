@@ -18,11 +18,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-
 from ..cli_inputs import seed_value
 from ..rigs.table1 import TABLE1
 from .gra import PARAMETERS, gra_tables, parameter_row
 from .store import FrameStore
+
 
 def run_frames(store_path: str, cases: list[str], frame_interval: float, workers: int, say=print):
     """The Table 1 cases the store lacks, `workers` at a time (one thread each; pydem.seed001.hoppers

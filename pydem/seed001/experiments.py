@@ -58,9 +58,9 @@ def _beverloo_per_frame(f: frame_data.Frames, train_cases, first_frames: dict) -
     return pred, {"C": c, "k": k}
 
 
-def _first_frames(store, size: int) -> dict:
+def _first_frames(store, size: int, cases=None) -> dict:
     s = FrameStore(store)
-    return {c: frame_data.shrink(s.read_case(c)["frames"][:1], size)[0] for c in s.cases()}
+    return {c: frame_data.shrink(s.read_case(c)["frames"][:1], size)[0] for c in (cases or s.cases())}
 
 
 def _train(name: str, build, f: frame_data.Frames, tr, va, epochs: int, batch: int, lr: float, seed: int, out: Path, say,
@@ -124,11 +124,13 @@ def point_to_point(store, out, size: int = 64, every: int = 2, epochs: int = 12,
     table1 = frame_data.load_frames(store, size=size, every=every)
     cases = sorted(table1.discharge)
     more = extra_hoppers(extra, cases, extra_per_packing)
-    f = frame_data.concat([table1] + [frame_data.load_frames(path, cases=sorted(c for c, v in more.items() if v == path),
-                                                             size=size, every=every) for path in dict.fromkeys(more.values())])
+    f = frame_data.concat([table1] + [frame_data.load_frames(path, cases=names, size=size, every=every)
+                                      for path, names in _by_store(more).items()])
     test_cases = [c for c in cases if c.endswith("-5")]       # one case of every packing
     val_cases = [c for c in cases if c.endswith("-4")]
-    first = {c: v for path in [store, *dict.fromkeys(more.values())] for c, v in _first_frames(path, size).items()}
+    first = _first_frames(store, size)
+    for path, names in _by_store(more).items():
+        first |= _first_frames(path, size, names)
     res = {"settings": {"size": size, "every": every, "epochs": epochs, "batch": batch, "lr": lr, "seed": seed,
                         "frames": int(len(table1.x)), "test_cases": test_cases, "validation_cases": val_cases,
                         "extra_hoppers": sorted(more), "extra_frames": int(len(f.x) - len(table1.x)), "device": str(dev)},
@@ -201,6 +203,14 @@ def extra_hoppers(stores, table1: list[str], per_packing: int | None = None) -> 
     return found
 
 
+def _by_store(more: dict) -> dict:
+    """{store: its cases, sorted} of extra_hoppers' {case: store}."""
+    out: dict = {}
+    for c, path in sorted(more.items()):
+        out.setdefault(path, []).append(c)
+    return out
+
+
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
             device: str = "auto", inputs: str = "grey", extra=(), extra_per_packing: int | None = None,
@@ -250,8 +260,8 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
         if len(folds) < 3:
             raise ValueError(f"{store}: cases in {len(folds)} fold(s); the pretrained protocol needs three or more")
         g_in = gauges.inputs(store, cases, size)
-        for path in sorted({str(v) for v in more.values()}):
-            g_in |= gauges.inputs(path, [c for c, v in more.items() if str(v) == path], size)
+        for path, names in _by_store(more).items():
+            g_in |= gauges.inputs(path, names, size)
         first = {c: first_part(len(d.x), fraction, window) for c, d in data.items()}
         for fold in folds:
             val_fold = validation_fold(fold, folds)

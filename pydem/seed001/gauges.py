@@ -16,6 +16,7 @@ import json
 
 import numpy as np
 
+from ..rigs.table1 import row_from_json
 from . import baselines, frame_data
 from .store import FrameStore
 
@@ -32,11 +33,10 @@ def inputs(store, cases, size: int) -> dict:
     for c in cases:
         d = st.read_case(c)
         raw = d["frames"]
-        row = json.loads(d["row"]) if "row" in d else None
+        row = row_from_json(json.loads(d["row"])) if "row" in d else None
         grey = frame_data.shrink(raw, size)
         out[c] = {"fill": baselines.fill_fraction(grey, grey[0]), "species": baselines.species_fill(raw),
-                  "fines_share": baselines.fines_count_share(c, None if row is None else
-                                                             tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]))}
+                  "fines_share": baselines.fines_count_share(c, row)}
     return out
 
 

@@ -26,9 +26,10 @@ def run_one(name: str, row: list, packing: str, frame_interval: float) -> dict:
     or {"error": reason}."""
     from ..rigs import RIGS, load
     from ..rigs.hopper import apply_row
+    from ..rigs.table1 import row_from_json
     cls, cfg_cls = RIGS["hopper"]
     cfg = load(cfg_cls, "default", None, [f"frame_interval={frame_interval}", "num_threads=1"])
-    apply_row(cfg, tuple(row[:9]) + (tuple(row[9]),) + tuple(row[10:]), packing)
+    apply_row(cfg, row_from_json(row), packing)
     t0 = time.perf_counter()
     try:
         res = cls(cfg).run(seed=0, images=True)
@@ -43,9 +44,8 @@ def run_one(name: str, row: list, packing: str, frame_interval: float) -> dict:
 
 def drawn(packing: str, hoppers: int, seed: int, volume_scale: float = 1.0) -> dict[str, list]:
     """{name: row} of the hoppers asked, rows as JSON-ready lists."""
-    from ..rigs.table1 import draw_like_table1
-    rows = draw_like_table1(packing, hoppers, seed, volume_scale)
-    return {k: [v[0], *v[1:9], list(v[9]), v[10]] for k, v in rows.items()}
+    from ..rigs.table1 import draw_like_table1, row_as_json
+    return {k: row_as_json(v) for k, v in draw_like_table1(packing, hoppers, seed, volume_scale).items()}
 
 
 def run_hoppers(store_path, packing: str, hoppers: int, seed: int = 1, frame_interval: float = 0.001,
@@ -86,6 +86,7 @@ def run_into_store(store: FrameStore, jobs: dict, frame_interval: float, workers
     and writes each into the store as it ends, with attrs[name] and its DEM time: a case whole, or
     a failure with its reason (also into `failed`), a progress line each."""
     from ..campaign.workers import run_local
+    from ..rigs.table1 import row_as_json
     names = list(jobs)
     t0, ended = time.perf_counter(), 0
 
@@ -108,6 +109,5 @@ def run_into_store(store: FrameStore, jobs: dict, frame_interval: float, workers
             f"{sum(k in failed for k in names)} failed, ~{left / 60:.0f} min left")
 
     if names:
-        run_local({i: (name, list(jobs[name][0][:9]) + [list(jobs[name][0][9]), jobs[name][0][10]], jobs[name][1],
-                       frame_interval) for i, name in enumerate(names)}, run_one, max(1, min(workers, len(names))),
-                  on_result, say)
+        run_local({i: (name, row_as_json(jobs[name][0]), jobs[name][1], frame_interval) for i, name in enumerate(names)},
+                  run_one, max(1, min(workers, len(names))), on_result, say)

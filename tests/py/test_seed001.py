@@ -134,12 +134,11 @@ def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
 def extra_store(path, names: dict):
     """A store of 'more hoppers' made from subset cases under other names (the plumbing, not the
     physics: no DEM), each with its Table 1-style row as pydem images hoppers stores it."""
-    from pydem.rigs.table1 import TABLE1
+    from pydem.rigs.table1 import TABLE1, row_as_json
     from pydem.seed001.store import FrameStore
     src, dst = FrameStore(SUBSET), FrameStore(path)
     for new, old in names.items():
         d = src.read_case(old)
-        row = TABLE1[old]
         dst.write_case(new, d["frames"], d["time"], d["discharge_time"], d["nrrp"],
-                       {"packing": new.split("-")[0], "row": json.dumps([*row[:9], list(row[9]), row[10]])})
+                       {"packing": new.split("-")[0], "row": json.dumps(row_as_json(TABLE1[old]))})
     return path
