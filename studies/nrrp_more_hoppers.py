@@ -27,26 +27,44 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 
-def evaluate(args) -> int:
+def packing_data(table1_store: str, extra_store: str, packing: str, size: int, window: int = 8):
+    """(the packing's Table 1 cases, its extra hoppers, the gauges' inputs, every case's NRRP, the
+    frame each reader starts at, the folds)."""
     from pydem.seed001 import experiments as ex
-    from pydem.seed001 import frame_data, gauges
+    from pydem.seed001 import gauges
     from pydem.seed001.store import FrameStore
-    table1 = [c for c in FrameStore(args.table1).cases() if ex.packing_of(c) == args.packing]
-    extra = FrameStore(args.store).cases()
-    g_in = gauges.inputs(args.table1, table1, args.size) | gauges.inputs(args.store, extra, args.size)
-    nrrp = {c: FrameStore(args.table1).read_case(c)["nrrp"] for c in table1} | \
-        {c: FrameStore(args.store).read_case(c)["nrrp"] for c in extra}
-    first = {c: ex.first_part(len(v), 0.2, 8) for c, v in nrrp.items()}
-    folds = sorted({ex.fold_of(c) for c in table1})
+    t1, more = FrameStore(table1_store), FrameStore(extra_store)
+    table1 = [c for c in t1.cases() if ex.packing_of(c) == packing]
+    extra = more.cases()
+    g_in = gauges.inputs(table1_store, table1, size) | gauges.inputs(extra_store, extra, size)
+    nrrp = {c: t1.read_case(c)["nrrp"] for c in table1} | {c: more.read_case(c)["nrrp"] for c in extra}
+    first = {c: ex.first_part(len(v), 0.2, window) for c, v in nrrp.items()}
+    return table1, extra, g_in, nrrp, first, sorted({ex.fold_of(c) for c in table1})
+
+
+def pretraining_cases(case: str, table1: list[str], folds: list[str]) -> list[str]:
+    """The Table 1 hoppers of the case's packing its network pretrains on (its pretraining folds)."""
+    from pydem.seed001 import experiments as ex
+    return [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)]
+
+
+def errors_on(case: str, train: list[str], g_in: dict, nrrp: dict, first: dict) -> dict:
+    """Each gauge's relative error on the case from its first[case] frame on, calibrated on
+    `train`, and the error of the gauge chosen from `train` alone (`chosen`)."""
+    from pydem.seed001 import frame_data, gauges
+    got = {g: frame_data.scores(nrrp[case][first[case]:], v)["relative_error"]
+           for g, v in gauges.readings(case, train, g_in, nrrp, first[case]).items()}
+    return got | {"chosen": got[gauges.chosen(g_in, nrrp, train, first)]}
+
+
+def evaluate(args) -> int:
+    from pydem.seed001 import gauges
+    table1, extra, g_in, nrrp, first, folds = packing_data(args.table1, args.store, args.packing, args.size)
     out = {"packing": args.packing, "size": args.size, "extra": extra, "cases": {}}
     for case in table1:
-        k = first[case]
-        base = [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)]
-        row = {}
-        for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra)):
-            row[label] = {g: frame_data.scores(nrrp[case][k:], v)["relative_error"]
-                          for g, v in gauges.readings(case, train, g_in, nrrp, k).items()}
-            row[label]["chosen"] = row[label][gauges.chosen(g_in, nrrp, train, first)]
+        base = pretraining_cases(case, table1, folds)
+        row = {label: errors_on(case, train, g_in, nrrp, first)
+               for label, train in (("table1", base), ("table1+extra", base + extra), ("extra", extra))}
         out["cases"][case] = row
         print(f"{case}: " + "  ".join(f"{lab}: fill {r['fill_level']:.3f} species {r['species']:.3f} chosen {r['chosen']:.3f}"
                                       for lab, r in row.items()))
@@ -68,27 +86,16 @@ def curve(args) -> int:
     with --extra-per-packing K (--networks). A power law err = a n^b through each reader's points
     (n = hoppers used) says where it would reach seed 001's 0.08 — an extrapolation, marked so."""
     from pydem.seed001 import experiments as ex
-    from pydem.seed001 import frame_data, gauges
-    from pydem.seed001.store import FrameStore
-    t1 = FrameStore(args.table1)
+    from pydem.seed001 import gauges
     out = {"counts": args.counts, "size": args.size, "target": TARGET, "packings": {}}
     for pk in args.packings:
-        table1 = [c for c in t1.cases() if ex.packing_of(c) == pk]
-        path = args.extra.replace("{packing}", pk)
-        extra = sorted(FrameStore(path).cases())
-        g_in = gauges.inputs(args.table1, table1, args.size) | gauges.inputs(path, extra, args.size)
-        nrrp = {c: t1.read_case(c)["nrrp"] for c in table1} | {c: FrameStore(path).read_case(c)["nrrp"] for c in extra}
-        first = {c: ex.first_part(len(v), 0.2, args.window) for c, v in nrrp.items()}
-        folds = sorted({ex.fold_of(c) for c in table1})
+        table1, extra, g_in, nrrp, first, folds = packing_data(args.table1, args.extra.replace("{packing}", pk), pk,
+                                                               args.size, args.window)
         rows = {}
         for k in [k for k in args.counts if k <= len(extra)]:
             errs = {g: [] for g in gauges.GAUGES + ("chosen",)}
             for case in table1:
-                train = [c for c in table1 if ex.fold_of(c) in ex.pretraining_folds(ex.fold_of(case), folds)] + extra[:k]
-                got = {g: frame_data.scores(nrrp[case][first[case]:], v)["relative_error"]
-                       for g, v in gauges.readings(case, train, g_in, nrrp, first[case]).items()}
-                got["chosen"] = got[gauges.chosen(g_in, nrrp, train, first)]
-                for g, e in got.items():
+                for g, e in errors_on(case, pretraining_cases(case, table1, folds) + extra[:k], g_in, nrrp, first).items():
                     errs[g].append(e)
             rows[k] = {"hoppers": len(folds) - 2 + k, **{g: float(np.mean(v)) for g, v in errs.items()}}
             print(f"{pk}, {rows[k]['hoppers']} hoppers: " + ", ".join(f"{g} {rows[k][g]:.3f}" for g in errs), flush=True)
