@@ -201,12 +201,38 @@ def diagnose(args):
                 out["sets"][-1]["first_pass"] = {"verdict": first["verdict"], "effects": first["effects"],
                                                  "rmse_before": first.get("rmse_before"), "rmse_after": first.get("rmse_after"),
                                                  "covered": covered(first.get("intervals", {}), row["inputs"])}
-                out["sets"][-1]["refinement"] = {"runs": ref["runs"], "failed": len(ref["failed"]),
-                                                 "cpu_seconds": ref["cpu_seconds"], "quantities": ref["quantities"]}
+                out["sets"][-1]["refinement"] = refinement_record(ref)
             s = out["sets"][-1]
             print(f"set {row['set']:2d} {row['kind']:28s} -> {s['verdict']:18s} {'+'.join(effects) or '-':28s} "
                   f"covered {sum(cover.values())}/{len(cover)}", flush=True)
             Path(args.out).write_text(json.dumps(out, indent=1))
+
+
+def refinement_record(ref: dict) -> dict:
+    """What the validation keeps of a diagnosis's refinement: runs, failures, CPU, the per-quantity
+    check of the correction, and each row's surrogate error in both passes beside its uncertainty."""
+    return {"runs": ref["runs"], "failed": len(ref["failed"]), "cpu_seconds": ref["cpu_seconds"],
+            "quantities": ref["quantities"],
+            "rows": [{k: x[k] for k in ("label", "uncertainty", "net_error_first", "net_error_second")} for x in ref["rows"]]}
+
+
+def surrogate_error(refined: list[dict]) -> str:
+    """The rows' surrogate error against their measurement uncertainty, first pass and refined: how
+    many rows it is below, and the median refined / first ratio, in all and per quantity (the sets
+    that recorded rows)."""
+    rows = [x for s in refined for x in s["refinement"].get("rows", []) if x["uncertainty"]]
+    if not rows:
+        return "  (no per-row surrogate errors recorded)"
+
+    def figures(xs) -> str:
+        below = [sum(x[k] < x["uncertainty"] for x in xs) for k in ("net_error_first", "net_error_second")]
+        ratio = np.median([x["net_error_second"] / x["net_error_first"] for x in xs if x["net_error_first"] > 0])
+        return f"below u in {below[0]} -> {below[1]} of {len(xs)} rows, refined / first {ratio:.2f}"
+    per_quantity = {}
+    for x in rows:
+        per_quantity.setdefault(x["label"].split(" (")[0], []).append(x)
+    return (f"  surrogate error (first pass -> refined, {sum('rows' in s['refinement'] for s in refined)} sets): "
+            f"{figures(rows)}\n" + "\n".join(f"    {q}: {figures(xs)}" for q, xs in sorted(per_quantity.items())))
 
 
 def covered(intervals: dict, truth: dict) -> dict:
@@ -267,16 +293,21 @@ def summary(args):
         print(f"  refinement runs per set {np.median(runs):.0f} (median; {sum(s['refinement']['failed'] for s in refined)} "
               f"failed in all), their CPU {np.median(cpu):.2f} h per set (median, max {max(cpu):.2f}); whole refined "
               f"diagnosis {np.median([s['seconds'] for s in refined]) / 3600:.2f} h of wall time per set (median)")
+        print(surrogate_error(refined))
         if args.markdown:
             lines = ["| set | kind | first pass | refined | error after/before: first, refined | coverage: first, refined "
-                     "| runs (failed) | run CPU (h) | wall (h) |", "|---|---|---|---|---|---|---|---|---|"]
+                     "| rows with surrogate error < u: first, refined | runs (failed) | run CPU (h) | wall (h) |",
+                     "|---|---|---|---|---|---|---|---|---|---|"]
             for s in refined:
                 f = s["first_pass"]
                 ratio = lambda d: f"{d['rmse_after'] / d['rmse_before']:.2f}" if d.get("rmse_after") else "-"  # noqa: E731
                 cov = lambda c: f"{sum(c.values())}/{len(c)}"  # noqa: E731
+                rows = [x for x in s["refinement"].get("rows", []) if x["uncertainty"]]
+                below = (", ".join(f"{sum(x[k] < x['uncertainty'] for x in rows)}/{len(rows)}"
+                                   for k in ("net_error_first", "net_error_second")) if rows else "-")
                 lines.append(f"| {s['set']} | {s['kind']} | {'+'.join(f['effects']) or f['verdict']} | "
                              f"{'+'.join(s['effects']) or s['verdict']} | {ratio(f)}, {ratio(s)} | {cov(f['covered'])}, "
-                             f"{cov(s['covered'])} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
+                             f"{cov(s['covered'])} | {below} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
                              f"{s['refinement']['cpu_seconds'] / 3600:.2f} | {s['seconds'] / 3600:.2f} |")
             Path(args.markdown).write_text("\n".join(lines) + "\n")
             print(f"  per-set table: {args.markdown}")
