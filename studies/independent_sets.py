@@ -23,7 +23,8 @@ passes; `summary` then scores the first pass too (the refinement's validation, d
 
     .venv/bin/python studies/independent_sets.py diagnose --journals studies/results/independent_sets_*.jsonl \
         --label refined16 --out studies/results/independent_sets.refined16.json --refine 16 --runs build/refine_runs16
-    (and --refine-design fixed --runs build/refine_runs_fixed for the simple alternative on the same budget)
+    (and --refine-design fixed --runs build/refine_runs_fixed for the simple alternative on the same budget;
+    `summary A.json B.json --common` scores both on the sets they share)
 
 The programme: ring shear at pre-shear 1, 2 and 5 kPa with shear points at 45 and 70 % (the
 stores shear at 30, 60 and 90 %), the angle of repose with its poured bulk density, the hopper at
@@ -278,11 +279,14 @@ def score_line(label: str, sc: dict) -> str:
 
 def summary(args):
     """Each results file scored (score); for a refined validation the first pass of the same sets
-    too, the runs and CPU time per set, and with --markdown a per-set table."""
-    for path in args.results:
-        r = json.loads(Path(path).read_text())
-        sets = [s for s in r["sets"] if "error" not in s]
-        print(score_line(r["label"], score(sets)) + f"; failed sets {len(r['sets']) - len(sets)}")
+    too, the runs and CPU time per set, and with --markdown a per-set table. With --common, only the
+    sets every file holds (two designs compared on the same sets)."""
+    files = [json.loads(Path(path).read_text()) for path in args.results]
+    common = set.intersection(*({s["set"] for s in r["sets"]} for r in files))
+    for r in files:
+        sets = [s for s in r["sets"] if "error" not in s and (not args.common or s["set"] in common)]
+        print(score_line(r["label"], score(sets)) + f"; failed sets {sum('error' in s for s in r['sets'])}"
+              + (f"; sets {' '.join(str(s['set']) for s in sets)}" if args.common else ""))
         refined = [s for s in sets if "first_pass" in s]
         if not refined:
             continue
@@ -333,6 +337,7 @@ def main() -> int:
     sm = sub.add_parser("summary")
     sm.add_argument("results", nargs="+")
     sm.add_argument("--markdown", help="a refined validation's per-set table, as Markdown, into this file")
+    sm.add_argument("--common", action="store_true", help="only the sets every results file holds")
     args = ap.parse_args()
     {"run": run, "diagnose": diagnose, "summary": summary}[args.cmd](args)
     return 0
