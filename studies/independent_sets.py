@@ -283,6 +283,7 @@ def summary(args):
     sets every file holds (two designs compared on the same sets)."""
     files = [json.loads(Path(path).read_text()) for path in args.results]
     common = set.intersection(*({s["set"] for s in r["sets"]} for r in files))
+    table = []  # the refined sets' Markdown lines, every file's
     for r in files:
         sets = [s for s in r["sets"] if "error" not in s and (not args.common or s["set"] in common)]
         print(score_line(r["label"], score(sets)) + f"; failed sets {sum('error' in s for s in r['sets'])}"
@@ -298,23 +299,27 @@ def summary(args):
               f"failed in all), their CPU {np.median(cpu):.2f} h per set (median, max {max(cpu):.2f}); whole refined "
               f"diagnosis {np.median([s['seconds'] for s in refined]) / 3600:.2f} h of wall time per set (median)")
         print(surrogate_error(refined))
-        if args.markdown:
-            lines = ["| set | kind | first pass | refined | error after/before: first, refined | coverage: first, refined "
-                     "| rows with surrogate error < u: first, refined | runs (failed) | run CPU (h) | wall (h) |",
-                     "|---|---|---|---|---|---|---|---|---|---|"]
-            for s in refined:
-                f = s["first_pass"]
-                ratio = lambda d: f"{d['rmse_after'] / d['rmse_before']:.2f}" if d.get("rmse_after") else "-"  # noqa: E731
-                cov = lambda c: f"{sum(c.values())}/{len(c)}"  # noqa: E731
-                rows = [x for x in s["refinement"].get("rows", []) if x["uncertainty"]]
-                below = (", ".join(f"{sum(x[k] < x['uncertainty'] for x in rows)}/{len(rows)}"
-                                   for k in ("net_error_first", "net_error_second")) if rows else "-")
-                lines.append(f"| {s['set']} | {s['kind']} | {'+'.join(f['effects']) or f['verdict']} | "
-                             f"{'+'.join(s['effects']) or s['verdict']} | {ratio(f)}, {ratio(s)} | {cov(f['covered'])}, "
-                             f"{cov(s['covered'])} | {below} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
-                             f"{s['refinement']['cpu_seconds'] / 3600:.2f} | {s['seconds'] / 3600:.2f} |")
-            Path(args.markdown).write_text("\n".join(lines) + "\n")
-            print(f"  per-set table: {args.markdown}")
+        table += [markdown_row(r["label"], s) for s in refined]
+    if args.markdown and table:
+        head = ["| results | set | kind | first pass | refined | error after/before: first, refined | coverage: first, "
+                "refined | rows with surrogate error < u: first, refined | runs (failed) | run CPU (h) | wall (h) |",
+                "|---|---|---|---|---|---|---|---|---|---|---|"]
+        Path(args.markdown).write_text("\n".join(head + table) + "\n")
+        print(f"per-set table: {args.markdown}")
+
+
+def markdown_row(label: str, s: dict) -> str:
+    """One refined set's line of the summary's Markdown table."""
+    f = s["first_pass"]
+    ratio = lambda d: f"{d['rmse_after'] / d['rmse_before']:.2f}" if d.get("rmse_after") else "-"  # noqa: E731
+    cov = lambda c: f"{sum(c.values())}/{len(c)}"  # noqa: E731
+    rows = [x for x in s["refinement"].get("rows", []) if x["uncertainty"]]
+    below = (", ".join(f"{sum(x[k] < x['uncertainty'] for x in rows)}/{len(rows)}"
+                       for k in ("net_error_first", "net_error_second")) if rows else "-")
+    return (f"| {label} | {s['set']} | {s['kind']} | {'+'.join(f['effects']) or f['verdict']} | "
+            f"{'+'.join(s['effects']) or s['verdict']} | {ratio(f)}, {ratio(s)} | {cov(f['covered'])}, "
+            f"{cov(s['covered'])} | {below} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
+            f"{s['refinement']['cpu_seconds'] / 3600:.2f} | {s['seconds'] / 3600:.2f} |")
 
 
 def main() -> int:
