@@ -217,16 +217,26 @@ def refinement_record(ref: dict) -> dict:
             "rows": [{k: x[k] for k in ("label", "uncertainty", "net_error_first", "net_error_second")} for x in ref["rows"]]}
 
 
+def rows_with_u(s: dict) -> list[dict]:
+    """A refined set's recorded rows that state a measurement uncertainty."""
+    return [x for x in s["refinement"].get("rows", []) if x["uncertainty"]]
+
+
+def rows_below_u(rows: list[dict]) -> tuple[int, int]:
+    """How many rows' surrogate error is below their uncertainty: (first pass, refined)."""
+    return tuple(sum(x[k] < x["uncertainty"] for x in rows) for k in ("net_error_first", "net_error_second"))
+
+
 def surrogate_error(refined: list[dict]) -> str:
     """The rows' surrogate error against their measurement uncertainty, first pass and refined: how
     many rows it is below, and the median refined / first ratio, in all and per quantity (the sets
     that recorded rows)."""
-    rows = [x for s in refined for x in s["refinement"].get("rows", []) if x["uncertainty"]]
+    rows = [x for s in refined for x in rows_with_u(s)]
     if not rows:
         return "  (no per-row surrogate errors recorded)"
 
     def figures(xs) -> str:
-        below = [sum(x[k] < x["uncertainty"] for x in xs) for k in ("net_error_first", "net_error_second")]
+        below = rows_below_u(xs)
         ratio = np.median([x["net_error_second"] / x["net_error_first"] for x in xs if x["net_error_first"] > 0])
         return f"below u in {below[0]} -> {below[1]} of {len(xs)} rows, refined / first {ratio:.2f}"
     per_quantity = {}
@@ -313,9 +323,8 @@ def markdown_row(label: str, s: dict) -> str:
     f = s["first_pass"]
     ratio = lambda d: f"{d['rmse_after'] / d['rmse_before']:.2f}" if d.get("rmse_after") else "-"  # noqa: E731
     cov = lambda c: f"{sum(c.values())}/{len(c)}"  # noqa: E731
-    rows = [x for x in s["refinement"].get("rows", []) if x["uncertainty"]]
-    below = (", ".join(f"{sum(x[k] < x['uncertainty'] for x in rows)}/{len(rows)}"
-                       for k in ("net_error_first", "net_error_second")) if rows else "-")
+    rows = rows_with_u(s)
+    below = ", ".join(f"{n}/{len(rows)}" for n in rows_below_u(rows)) if rows else "-"
     return (f"| {label} | {s['set']} | {s['kind']} | {'+'.join(f['effects']) or f['verdict']} | "
             f"{'+'.join(s['effects']) or s['verdict']} | {ratio(f)}, {ratio(s)} | {cov(f['covered'])}, "
             f"{cov(s['covered'])} | {below} | {s['refinement']['runs']} ({s['refinement']['failed']}) | "
