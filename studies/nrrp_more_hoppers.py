@@ -35,7 +35,7 @@ def packing_data(table1_store: str, extra_store: str, packing: str, size: int, w
     from pydem.seed001.store import FrameStore
     t1, more = FrameStore(table1_store), FrameStore(extra_store)
     table1 = [c for c in t1.cases() if ex.packing_of(c) == packing]
-    extra = more.cases()
+    extra = [c for c in more.cases() if ex.packing_of(c) == packing]  # a store may hold other packings too
     g_in = gauges.inputs(table1_store, table1, size) | gauges.inputs(extra_store, extra, size)
     nrrp = {c: t1.read_case(c)["nrrp"] for c in table1} | {c: more.read_case(c)["nrrp"] for c in extra}
     first = {c: ex.first_part(len(v), 0.2, window) for c, v in nrrp.items()}

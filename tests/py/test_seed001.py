@@ -2,6 +2,7 @@
 Table 1, every 20th frame of the full set; docs/seed001.md): the stored labels are consistent
 with the physics of a discharge, the GRA weights are percentages, and the two cheap experiments
 and the report run end to end (tiny settings: this checks the chain, not the networks' skill)."""
+import argparse
 import json
 import os
 from pathlib import Path
@@ -88,6 +89,18 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert all(r["gauge"] in gauges.GAUGES and 0 <= min(r["predicted"]) <= max(r["predicted"]) <= 1
                for r in res["cases"].values())
     assert res["cases"]["A-1"]["fill_level_nrrp"] != proc["cases"]["A-1"]["fill_level_nrrp"]  # calibrated on more
+    # the curve of error against hoppers used: the gauges at each count, the networks' points from
+    # their runs (proc: no extra hopper; res: one per packing), the power law through them
+    curve = more_hoppers_study().curve
+    args = argparse.Namespace(table1=str(SUBSET), extra=str(extra), packings=list(ex.PACKINGS), counts=[0, 1, 2], size=32,
+                              window=2, networks=[str(tmp_path), str(tmp_path / "r")], out=str(tmp_path / "curve.json"),
+                              figure=str(tmp_path / "curve.png"))
+    assert curve(args) == 0 and (tmp_path / "curve.png").stat().st_size > 0
+    got = json.loads((tmp_path / "curve.json").read_text())["packings"]["B1"]
+    assert [r["hoppers"] for r in got["gauges"].values()] == [3, 4, 5] and got["extra_available"] == 2
+    assert {k: r["hoppers"] for k, r in got["network"].items()} == {"0": 3, "1": 4}
+    assert got["network"]["1"]["net"] == res["per_packing"]["B1"]["net"] and got["network"]["1"]["target"] == "residual"
+    assert set(got["reach"]) == {"chosen gauge", "network"}
     # AlexNet-FC: the extra hoppers train the leave-cases-out split only; the random split stays Table 1's
     more = ex.point_to_point(SUBSET, tmp_path / "pe", size=64, every=4, epochs=1, extra=[extra], say=lambda *a: None)
     assert more["settings"]["extra_hoppers"] == sorted(f"{pk}-x0{i}" for pk in ex.PACKINGS for i in (1, 2))
@@ -129,6 +142,26 @@ def test_the_gpu_runner_reads_frames_and_table1_without_the_compiled_binding():
                          env={**os.environ, "SEED001_NO_BINDING": "1"})
     assert out.returncode == 0, out.stderr
     assert out.stdout.split()[-1] == "25"
+
+
+def more_hoppers_study():
+    """studies/nrrp_more_hoppers.py as a module (studies/ is not a package)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("nrrp_more_hoppers", ROOT / "studies/nrrp_more_hoppers.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_the_hoppers_needed_for_the_target_follow_the_power_law_through_the_points():
+    """err = a n^b through (3, 0.2) and (12, 0.1): b = -1/2, a = 0.2 sqrt 3, so 0.08 is reached at
+    n = (a / 0.08)^2 = 18.75 hoppers, beyond the points (an extrapolation); a rising error reaches nothing."""
+    reach = more_hoppers_study().reach
+    r = reach([(3, 0.2), (12, 0.1)])
+    assert r["exponent"] == pytest.approx(-0.5) and r["hoppers_for_target"] == pytest.approx(18.75)
+    assert r["extrapolated"] and not r["reached"]
+    assert reach([(3, 0.1), (12, 0.05)])["reached"] and not reach([(3, 0.1), (12, 0.05)])["extrapolated"]
+    assert reach([(3, 0.1), (12, 0.2)])["hoppers_for_target"] is None
 
 
 def extra_store(path, names: dict):
