@@ -131,6 +131,26 @@ def reach(points: list[tuple[int, float]]) -> dict:
             "reached": bool(np.min(e) <= TARGET), "extrapolated": bool(needed is not None and needed > n.max())}
 
 
+def table(args) -> int:
+    """A Markdown table per packing of `process` runs (--networks): each run's network, fine-tuned
+    and zero-shot, and its two gauges calibrated on the same training hoppers; the last column the
+    better of the last run's gauges per packing — chosen on the test cases, so the strictest bar."""
+    from pydem.seed001 import gauges
+    runs = [(Path(d).name, json.loads((Path(d) / "process.json").read_text())) for d in args.networks]
+    head = ["packing"] + [f"{name}: net / zero-shot / {' / '.join(gauges.GAUGES)}" for name, _ in runs] + ["better gauge"]
+    print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
+    for pk in args.packings:
+        cells = []
+        for _, run in runs:
+            v = run["per_packing"].get(pk, {})
+            cells.append(" / ".join(f"{v[k]:.3f}" if k in v else "—" for k in ("net", "zero_shot") + gauges.GAUGES))
+        last = runs[-1][1]["per_packing"].get(pk, {})
+        better = min((last[g], g) for g in gauges.GAUGES if g in last) if last else None
+        last_cell = f"{better[0]:.3f} ({better[1].replace('_', ' ')})" if better else "—"
+        print(f"| {pk} | " + " | ".join(cells) + f" | {last_cell} |")
+    return 0
+
+
 def curve_figure(res: dict, path: str):
     import matplotlib
     matplotlib.use("Agg")
@@ -181,8 +201,11 @@ def main() -> int:
     c.add_argument("--networks", nargs="*", help="process output folders made with --extra-per-packing K")
     c.add_argument("--out", required=True)
     c.add_argument("--figure")
+    t = sub.add_parser("table", help="Markdown per packing of process runs: network, zero-shot, gauges")
+    t.add_argument("--networks", nargs="+", required=True, help="process output folders")
+    t.add_argument("--packings", nargs="+", default=["A", "B1", "B2", "B3", "B4"])
     args = ap.parse_args()
-    return evaluate(args) if args.cmd == "evaluate" else curve(args)
+    return {"evaluate": evaluate, "curve": curve, "table": table}[args.cmd](args)
 
 
 if __name__ == "__main__":

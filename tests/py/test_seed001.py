@@ -50,7 +50,7 @@ def test_pydem_images_is_the_seed001_command_line():
 
 
 @pytest.mark.slow
-def test_experiments_and_report_run_on_the_subset(tmp_path):
+def test_experiments_and_report_run_on_the_subset(tmp_path, capsys):
     import torch
     from pydem.seed001 import experiments as ex
     from pydem.seed001.report import write
@@ -101,6 +101,10 @@ def test_experiments_and_report_run_on_the_subset(tmp_path):
     assert {k: r["hoppers"] for k, r in got["network"].items()} == {"0": 3, "1": 4}
     assert got["network"]["1"]["net"] == res["per_packing"]["B1"]["net"] and got["network"]["1"]["target"] == "residual"
     assert set(got["reach"]) == {"chosen gauge", "network"}
+    capsys.readouterr()
+    assert more_hoppers_study().table(argparse.Namespace(networks=args.networks, packings=list(ex.PACKINGS))) == 0
+    rows = capsys.readouterr().out.splitlines()[2:]
+    assert [r.split(" | ")[0] for r in rows] == [f"| {pk}" for pk in ex.PACKINGS] and all(r.count(" / ") == 6 for r in rows)
     # AlexNet-FC: the extra hoppers train the leave-cases-out split only; the random split stays Table 1's
     more = ex.point_to_point(SUBSET, tmp_path / "pe", size=64, every=4, epochs=1, extra=[extra], say=lambda *a: None)
     assert more["settings"]["extra_hoppers"] == sorted(f"{pk}-x0{i}" for pk in ex.PACKINGS for i in (1, 2))
