@@ -101,7 +101,7 @@ def curve(args) -> int:
             print(f"{pk}, {rows[k]['hoppers']} hoppers: " + ", ".join(f"{g} {rows[k][g]:.3f}" for g in errs), flush=True)
         out["packings"][pk] = {"gauges": rows, "extra_available": len(extra)}
     for d in args.networks or []:
-        run = json.loads((Path(d) / "process.json").read_text())
+        run = process_run(d)
         per = {pk: sum(ex.packing_of(c) == pk for c in run["settings"].get("extra_hoppers", [])) for pk in args.packings}
         for pk in args.packings:
             if pk in run["per_packing"]:
@@ -116,6 +116,12 @@ def curve(args) -> int:
     if args.figure:
         curve_figure(out, args.figure)
     return 0
+
+
+def process_run(where: str) -> dict:
+    """A `process` run's results: its JSON file, or the --out folder holding process.json."""
+    path = Path(where)
+    return json.loads((path if path.suffix == ".json" else path / "process.json").read_text())
 
 
 def reach(points: list[tuple[int, float]]) -> dict:
@@ -136,7 +142,7 @@ def table(args) -> int:
     and zero-shot, and its two gauges calibrated on the same training hoppers; the last column the
     better of the last run's gauges per packing — chosen on the test cases, so the strictest bar."""
     from pydem.seed001 import gauges
-    runs = [(Path(d).name, json.loads((Path(d) / "process.json").read_text())) for d in args.networks]
+    runs = [(Path(d).stem if d.endswith(".json") else Path(d).name, process_run(d)) for d in args.networks]
     head = ["packing"] + [f"{name}: net / zero-shot / {' / '.join(gauges.GAUGES)}" for name, _ in runs] + ["better gauge"]
     print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
     for pk in args.packings:
@@ -198,11 +204,11 @@ def main() -> int:
     c.add_argument("--size", type=int, default=224, help="frame side of the fill-level gauge")
     c.add_argument("--window", type=int, default=8, help="the process runs' window: the readers start after "
                                                          "max(window + 2, 20 %% of the frames)")
-    c.add_argument("--networks", nargs="*", help="process output folders made with --extra-per-packing K")
+    c.add_argument("--networks", nargs="*", help="process runs (--out folders or their JSON) made with --extra-per-packing K")
     c.add_argument("--out", required=True)
     c.add_argument("--figure")
     t = sub.add_parser("table", help="Markdown per packing of process runs: network, zero-shot, gauges")
-    t.add_argument("--networks", nargs="+", required=True, help="process output folders")
+    t.add_argument("--networks", nargs="+", required=True, help="process runs: --out folders or their JSON")
     t.add_argument("--packings", nargs="+", default=["A", "B1", "B2", "B3", "B4"])
     args = ap.parse_args()
     return {"evaluate": evaluate, "curve": curve, "table": table}[args.cmd](args)

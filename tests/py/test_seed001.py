@@ -102,7 +102,8 @@ def test_experiments_and_report_run_on_the_subset(tmp_path, capsys):
     assert got["network"]["1"]["net"] == res["per_packing"]["B1"]["net"] and got["network"]["1"]["target"] == "residual"
     assert set(got["reach"]) == {"chosen gauge", "network"}
     capsys.readouterr()
-    assert more_hoppers_study().table(argparse.Namespace(networks=args.networks, packings=list(ex.PACKINGS))) == 0
+    runs = [str(tmp_path / "process.json"), str(tmp_path / "r")]  # a run's JSON or its folder
+    assert more_hoppers_study().table(argparse.Namespace(networks=runs, packings=list(ex.PACKINGS))) == 0
     rows = capsys.readouterr().out.splitlines()[2:]
     assert [r.split(" | ")[0] for r in rows] == [f"| {pk}" for pk in ex.PACKINGS] and all(r.count(" / ") == 6 for r in rows)
     # AlexNet-FC: the extra hoppers train the leave-cases-out split only; the random split stays Table 1's
