@@ -124,17 +124,25 @@ def process_run(where: str) -> dict:
     return json.loads((path if path.suffix == ".json" else path / "process.json").read_text())
 
 
-def reach(points: list[tuple[int, float]]) -> dict:
-    """err = a n^b fitted through (n, err) by least squares in logs; the n where it would reach
-    TARGET (None when the error does not fall with n)."""
-    points = [(n, e) for n, e in points if np.isfinite(e) and e > 0]
+def reach(points: list[tuple[int, float]], tail: int = 3) -> dict:
+    """Where a reader reaches TARGET. Measured when it does: the fewest hoppers whose error is at
+    or below it. Otherwise extrapolated by err = a n^b, fitted by least squares in logs through
+    the `tail` points of most hoppers — the curve's present slope, since a reader whose form
+    limits it flattens, and a fit through all points would promise what the last ones no longer
+    show (None when the error no longer falls)."""
+    points = sorted((n, e) for n, e in points if np.isfinite(e) and e > 0)
+    none = {"exponent": None, "a": None, "fitted_from": None, "hoppers_for_target": None, "reached": False,
+            "extrapolated": False}
     if len(points) < 2:
-        return {"exponent": None, "a": None, "hoppers_for_target": None, "reached": False, "extrapolated": False}
-    n, e = (np.array(v, float) for v in zip(*points))
+        return none
+    hit = [n for n, e in points if e <= TARGET]
+    n, e = (np.array(v, float) for v in zip(*points[-tail:]))
     b, log_a = np.polyfit(np.log(n), np.log(e), 1)
+    fit = {"exponent": float(b), "a": float(np.exp(log_a)), "fitted_from": int(n[0])}
+    if hit:
+        return none | fit | {"hoppers_for_target": hit[0], "reached": True}
     needed = float(np.exp((np.log(TARGET) - log_a) / b)) if b < 0 else None
-    return {"exponent": float(b), "a": float(np.exp(log_a)), "hoppers_for_target": needed,
-            "reached": bool(np.min(e) <= TARGET), "extrapolated": bool(needed is not None and needed > n.max())}
+    return none | fit | {"hoppers_for_target": needed, "extrapolated": needed is not None}
 
 
 def table(args) -> int:
@@ -169,8 +177,8 @@ def curve_figure(res: dict, path: str):
             n = sorted((r["hoppers"], r[key]) for r in pts.values())
             ax.plot(*zip(*n), style, label=name)
             fit = v["reach"].get(name)
-            if fit and fit["hoppers_for_target"]:
-                xs = np.geomspace(n[0][0], max(n[-1][0], min(fit["hoppers_for_target"], 1000)), 50)
+            if fit and fit["extrapolated"]:
+                xs = np.geomspace(fit["fitted_from"], min(fit["hoppers_for_target"], 1000), 50)
                 ax.plot(xs, fit["a"] * xs ** fit["exponent"], ":", color=ax.lines[-1].get_color())
         ax.axhline(res["target"], color="k", lw=0.8, ls="--")
         ax.set_xscale("log")

@@ -158,14 +158,18 @@ def more_hoppers_study():
     return mod
 
 
-def test_the_hoppers_needed_for_the_target_follow_the_power_law_through_the_points():
+def test_the_hoppers_needed_for_the_target_follow_the_power_law_through_the_last_points():
     """err = a n^b through (3, 0.2) and (12, 0.1): b = -1/2, a = 0.2 sqrt 3, so 0.08 is reached at
-    n = (a / 0.08)^2 = 18.75 hoppers, beyond the points (an extrapolation); a rising error reaches nothing."""
+    n = (a / 0.08)^2 = 18.75 hoppers, beyond the points (an extrapolation). The fit takes the last
+    three points only: a first point far above them does not change it. A reader that reaches the
+    target is read off the points (the fewest hoppers at or below it); a rising error reaches nothing."""
     reach = more_hoppers_study().reach
-    r = reach([(3, 0.2), (12, 0.1)])
-    assert r["exponent"] == pytest.approx(-0.5) and r["hoppers_for_target"] == pytest.approx(18.75)
-    assert r["extrapolated"] and not r["reached"]
-    assert reach([(3, 0.1), (12, 0.05)])["reached"] and not reach([(3, 0.1), (12, 0.05)])["extrapolated"]
+    for points in ([(3, 0.2), (12, 0.1)], [(1, 5.0), (3, 0.2), (6, 0.2 / 2 ** 0.5), (12, 0.1)]):
+        r = reach(points)
+        assert r["exponent"] == pytest.approx(-0.5) and r["hoppers_for_target"] == pytest.approx(18.75)
+        assert r["extrapolated"] and not r["reached"] and r["fitted_from"] == 3
+    got = reach([(3, 0.1), (6, 0.07), (12, 0.05)])
+    assert got["reached"] and got["hoppers_for_target"] == 6 and not got["extrapolated"]
     assert reach([(3, 0.1), (12, 0.2)])["hoppers_for_target"] is None
 
 
