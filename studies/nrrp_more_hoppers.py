@@ -185,6 +185,7 @@ def curve_figure(res: dict, path: str):
         ax.set_yscale("log")
         ax.set_xlim(2.5, 400)
         ax.set_xticks([3, 6, 12, 24, 48, 96, 192], labels=["3", "6", "12", "24", "48", "96", "192"])
+        ax.set_yticks([0.05, 0.08, 0.1, 0.2, 0.5, 1, 2], labels=["0.05", "0.08", "0.1", "0.2", "0.5", "1", "2"])
         ax.minorticks_off()
         ax.set_title(pk)
         ax.set_xlabel("hoppers used per packing")
