@@ -114,6 +114,9 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
             e.add_argument("--target", choices=("nrrp", "residual"), default="nrrp",
                            help="what the network learns: the NRRP (default), or its residual on the image gauge "
                                 "chosen per packing from the training hoppers")
+            e.add_argument("--warm-start", metavar="DIR",
+                           help="the --out folder of an earlier pretrained process run (same store, inputs, size): "
+                                "each fold's network starts from its pretrained weights")
     rp = sub.add_parser("report", help="HTML + Markdown report of the GRA and the experiments' results")
     rp.add_argument("--store", required=True)
     rp.add_argument("--results", required=True, help="the experiments' --out directory")
@@ -153,7 +156,8 @@ def main(argv=None, prog: str = "python -m pydem.seed001") -> int:
             kw |= {k: v for k, v in (("models", args.models), ("time_budget", args.time_budget)) if v is not None}
         if args.cmd == "process":
             kw.pop("every", None)
-            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride, "target": args.target}
+            kw |= {"protocol": args.protocol, "inputs": args.inputs, "stride": args.stride, "target": args.target,
+                   "warm_start": args.warm_start}
         if args.cmd != "compare":
             kw |= {"extra": args.extra, "extra_per_packing": args.extra_per_packing}
         run = {"compare": ex.compare, "point-to-point": ex.point_to_point, "process": ex.process}[args.cmd]

@@ -182,6 +182,17 @@ def _read_later(model, f: frame_data.Frames, k: int, window: int, scaling: dict,
     return np.clip(out + (0.0 if base is None else base[k:]), 0.0, 1.0)
 
 
+def _pretrained_weights(run: Path, fold: str) -> dict:
+    """The best-validation weights of fold `fold`'s pretraining in an earlier `process` run's folder."""
+    ck = run / f"lstm_pretrain_fold{fold}.pt"
+    if not ck.exists():
+        raise ValueError(f"warm start: {ck} not found; the run must be a pretrained `process` run on the same store")
+    state = torch.load(ck, weights_only=False, map_location="cpu")["state"]
+    if state.get("best_weights") is None:
+        raise ValueError(f"warm start: {ck} holds no finished epoch")
+    return state["best_weights"]
+
+
 def _window_mse(model, xw, yw, scaling: dict) -> float:
     return float(np.mean((training.predict(model, xw, scaling).reshape(yw.shape) - yw) ** 2))
 
@@ -214,7 +225,7 @@ def _by_store(more: dict) -> dict:
 def process(store, out, size: int = 64, window: int = 8, epochs: int | None = None, lr: float = 3e-4, seed: int = 0,
             fraction: float = 0.2, protocol: str = "pretrained", stride: int = 4, finetune_epochs: int = 10,
             device: str = "auto", inputs: str = "grey", extra=(), extra_per_packing: int | None = None,
-            target: str = "nrrp", say=print) -> dict:
+            target: str = "nrrp", warm_start=None, say=print) -> dict:
     """NRRP(t) of each case from its frames, predicted beyond the first `fraction` of them.
 
     protocol "per-case" (seed 001's): the CNN-LSTM trained on windows of the case's first
@@ -234,13 +245,19 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
     calibration — never its validation or test. `target` "residual": the network learns the NRRP
     minus the reading of the gauge chosen, per packing, from the fold's training hoppers alone
     (gauges.chosen; on a training hopper the gauge calibrated on the others, gauges.cross_fitted),
-    and adds that reading back."""
+    and adds that reading back. `warm_start`: the --out folder of an earlier pretrained run on the
+    same store, inputs and size; each fold's network starts from that run's pretrained weights for
+    the fold (its best validation epoch) instead of at random — a network pretrained on the NRRP
+    already reads the fill from the frames, where one learning the small residual from scratch may
+    settle on its mean."""
     if protocol not in ("pretrained", "per-case"):
         raise ValueError(f"protocol: 'pretrained' or 'per-case', got {protocol!r}")
     if target not in ("nrrp", "residual"):
         raise ValueError(f"target: 'nrrp' or 'residual', got {target!r}")
     if protocol != "pretrained" and (extra or target != "nrrp"):
         raise ValueError("extra hoppers and the residual target go with the pretrained protocol")
+    if warm_start is not None and protocol != "pretrained":
+        raise ValueError("a warm start goes with the pretrained protocol")
     epochs = epochs if epochs is not None else (8 if protocol == "pretrained" else 40)
     out = Path(out)
     dev = training.pick_device(device)
@@ -250,6 +267,7 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
                         "protocol": protocol, "inputs": inputs, "gradient_clip": LSTM_CLIP, "device": str(dev)}
            | ({"stride": stride, "finetune_epochs": finetune_epochs, "finetune_lr": lr / 10, "target": target,
                "extra_stores": [str(x) for x in extra or ()], "extra_hoppers": sorted(more)}
+              | ({"warm_start": str(warm_start)} if warm_start is not None else {})
               if protocol == "pretrained" else {}),
            "machine": _machine(dev), "cases": {}}
     data = {c: frame_data.load_frames(more.get(c, store), cases=[c], size=size, inputs=inputs) for c in cases + list(more)}
@@ -284,7 +302,13 @@ def process(store, out, size: int = 64, window: int = 8, epochs: int | None = No
                 + (f" ({len(more)} of them extra)" if more else "") + f" (validation: fold {val_fold}, {len(xv)} windows)"
                 + (f"; learning the residual on the gauge chosen per packing: {chosen}" if chosen else ""))
             torch.manual_seed(seed)
-            model = cnn.CNNLSTM(in_channels=xt.shape[2]).to(dev)
+            model = cnn.CNNLSTM(in_channels=xt.shape[2])
+            if warm_start is not None:
+                try:
+                    model.load_state_dict(_pretrained_weights(Path(warm_start), fold))
+                except RuntimeError as exc:  # another network's shapes (inputs, size)
+                    raise ValueError(f"warm start from {warm_start}: its networks do not fit these inputs ({exc})") from exc
+            model = model.to(dev)
             t0 = time.perf_counter()
             scaling = training.fit(model, xt, yt, xv, yv, epochs=epochs, batch=8, lr=lr, seed=seed, clip=LSTM_CLIP,
                                    checkpoint=out / f"lstm_pretrain_fold{fold}.pt", progress=EpochProgress(say))

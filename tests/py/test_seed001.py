@@ -111,6 +111,15 @@ def test_experiments_and_report_run_on_the_subset(tmp_path, capsys):
     assert more["settings"]["extra_hoppers"] == sorted(f"{pk}-x0{i}" for pk in ex.PACKINGS for i in (1, 2))
     assert set(more["splits"]["leave_cases_out"]["test"]["case"]) == set(p2p["settings"]["test_cases"])
     assert more["settings"]["frames"] + more["settings"]["extra_frames"] > more["settings"]["frames"]
+    # a warm start takes each fold's pretrained weights of an earlier run: with no further epoch on
+    # the same targets it reads every case exactly as that run did before fine-tuning
+    warm = ex.process(SUBSET, tmp_path / "w", size=32, window=2, epochs=0, fraction=0.4, finetune_epochs=2,
+                      warm_start=tmp_path, say=lambda *a: None)
+    assert all(warm["cases"][c]["zero_shot"] == proc["cases"][c]["zero_shot"] for c in proc["cases"])
+    with pytest.raises(ValueError, match="do not fit these inputs"):  # the grey run's networks, species inputs
+        ex.process(SUBSET, tmp_path / "w2", inputs="species", warm_start=tmp_path, **kw)
+    with pytest.raises(ValueError, match="not found"):
+        ex.process(SUBSET, tmp_path / "w3", warm_start=tmp_path / "nothing", **kw)
     clash = extra_store(tmp_path / "clash.h5", {"A-1": "A-1"})  # a test case among the training hoppers: refused
     with pytest.raises(ValueError, match="A-1 is a Table 1 case"):
         ex.process(SUBSET, tmp_path / "c", extra=[clash], **kw)
