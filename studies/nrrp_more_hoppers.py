@@ -105,17 +105,35 @@ def curve(args) -> int:
         per = {pk: sum(ex.packing_of(c) == pk for c in run["settings"].get("extra_hoppers", [])) for pk in args.packings}
         for pk in args.packings:
             if pk in run["per_packing"]:
-                out["packings"][pk].setdefault("network", {})[str(per[pk])] = {
-                    "hoppers": 3 + per[pk], "net": run["per_packing"][pk]["net"], "run": str(d),
-                    "target": run["settings"].get("target", "nrrp"), "inputs": run["settings"].get("inputs")}
+                points = out["packings"][pk].setdefault("network", {})
+                if str(per[pk]) in points:
+                    raise SystemExit(f"{d} and {points[str(per[pk])]['run']}: both with {per[pk]} extra hoppers of "
+                                     f"{pk}; pass one run per count")
+                points[str(per[pk])] = {"hoppers": 3 + per[pk], "net": run["per_packing"][pk]["net"], "run": str(d),
+                                        "training": training_of(run)}
     for pk, v in out["packings"].items():
         v["reach"] = {name: reach([(r["hoppers"], r[key]) for r in pts.values()])
                       for name, pts, key in (("chosen gauge", v["gauges"], "chosen"),
-                                             ("network", v.get("network", {}), "net")) if len(pts) >= 2}
+                                             ("network", comparable(v.get("network", {})), "net")) if len(pts) >= 2}
     Path(args.out).write_text(json.dumps(out, indent=1))
     if args.figure:
         curve_figure(out, args.figure)
     return 0
+
+
+def training_of(run: dict) -> dict:
+    """What a network point depends on besides its hoppers: inputs, target, size, window, stride, epochs."""
+    keys = ("inputs", "target", "size", "window", "stride", "epochs")
+    return {k: run["settings"].get(k, "nrrp" if k == "target" else None) for k in keys}
+
+
+def comparable(points: dict) -> dict:
+    """The network points trained like the one of most hoppers: a power law through runs with
+    another stride or epoch count would read a change of step budget as the hoppers' effect."""
+    if not points:
+        return {}
+    last = max(points.values(), key=lambda r: r["hoppers"])["training"]
+    return {k: r for k, r in points.items() if r["training"] == last}
 
 
 def process_run(where: str) -> dict:
@@ -171,11 +189,16 @@ def curve_figure(res: dict, path: str):
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, len(res["packings"]), figsize=(3.2 * len(res["packings"]), 3.2), sharey=True, squeeze=False)
     for ax, (pk, v) in zip(axes[0], res["packings"].items()):
-        for name, pts, key, style in (("chosen gauge", v["gauges"], "chosen", "o-"), ("network", v.get("network", {}), "net", "s-")):
+        net = v.get("network", {})
+        same = comparable(net)
+        others = sorted((r["hoppers"], r["net"]) for k, r in net.items() if k not in same)
+        for name, pts, key, style in (("chosen gauge", v["gauges"], "chosen", "o-"), ("network", same, "net", "s-")):
             if not pts:
                 continue
             n = sorted((r["hoppers"], r[key]) for r in pts.values())
             ax.plot(*zip(*n), style, label=name)
+            if name == "network" and others:
+                ax.plot(*zip(*others), "s", mfc="none", color=ax.lines[-1].get_color(), label="network, other budget")
             fit = v["reach"].get(name)
             if fit and fit["extrapolated"]:
                 xs = np.geomspace(fit["fitted_from"], min(fit["hoppers_for_target"], 1000), 50)

@@ -99,8 +99,9 @@ def test_experiments_and_report_run_on_the_subset(tmp_path, capsys):
     got = json.loads((tmp_path / "curve.json").read_text())["packings"]["B1"]
     assert [r["hoppers"] for r in got["gauges"].values()] == [3, 4, 5] and got["extra_available"] == 2
     assert {k: r["hoppers"] for k, r in got["network"].items()} == {"0": 3, "1": 4}
-    assert got["network"]["1"]["net"] == res["per_packing"]["B1"]["net"] and got["network"]["1"]["target"] == "residual"
-    assert set(got["reach"]) == {"chosen gauge", "network"}
+    assert got["network"]["1"]["net"] == res["per_packing"]["B1"]["net"] and got["network"]["1"]["training"]["target"] == "residual"
+    # the two runs learnt different targets: no power law through them, only the gauge's
+    assert set(got["reach"]) == {"chosen gauge"}
     capsys.readouterr()
     runs = [str(tmp_path / "process.json"), str(tmp_path / "r")]  # a run's JSON or its folder
     assert more_hoppers_study().table(argparse.Namespace(networks=runs, packings=list(ex.PACKINGS))) == 0
@@ -180,6 +181,14 @@ def test_the_hoppers_needed_for_the_target_follow_the_power_law_through_the_last
     got = reach([(3, 0.1), (6, 0.07), (12, 0.05)])
     assert got["reached"] and got["hoppers_for_target"] == 6 and not got["extrapolated"]
     assert reach([(3, 0.1), (12, 0.2)])["hoppers_for_target"] is None
+
+
+def test_the_networks_power_law_takes_only_runs_trained_like_the_largest():
+    comparable = more_hoppers_study().comparable
+    budget = {"inputs": "species", "target": "nrrp", "size": 64, "window": 8, "stride": 16, "epochs": 4}
+    points = {"0": {"hoppers": 3, "training": budget | {"stride": 8, "epochs": 8}},
+              "6": {"hoppers": 9, "training": budget}, "12": {"hoppers": 15, "training": budget}}
+    assert set(comparable(points)) == {"6", "12"} and comparable({}) == {}
 
 
 def extra_store(path, names: dict):
