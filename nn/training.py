@@ -3,7 +3,7 @@
 seeded, with a progress callback (epoch, loss, frames/s, time left) and a checkpoint after every
 epoch from which a killed training resumes; on the device the model sits on (`pick_device`: a GPU
 when torch sees one, bfloat16 autocast there; nothing requires one); `windows` for the recurrent
-network; `predict`."""
+network; `predict`; `best_weights` of a checkpoint, to start another training from."""
 from __future__ import annotations
 
 import contextlib
@@ -107,6 +107,17 @@ def fit(model: torch.nn.Module, x: np.ndarray, y: np.ndarray, x_val: np.ndarray,
         model.load_state_dict(state["best_weights"])
     model.eval()
     return {"history": state["history"], "mean": mean, "sd": sd}
+
+
+def best_weights(checkpoint: str | Path) -> dict:
+    """The best-validation weights saved in a `fit` checkpoint (to start another training from)."""
+    ck = Path(checkpoint)
+    if not ck.exists():
+        raise ValueError(f"{ck} not found")
+    weights = torch.load(ck, weights_only=False, map_location="cpu")["state"]["best_weights"]
+    if weights is None:
+        raise ValueError(f"{ck} holds no finished epoch")
+    return weights
 
 
 def windows(x: np.ndarray, y: np.ndarray, length: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:

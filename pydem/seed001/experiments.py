@@ -184,13 +184,10 @@ def _read_later(model, f: frame_data.Frames, k: int, window: int, scaling: dict,
 
 def _pretrained_weights(run: Path, fold: str) -> dict:
     """The best-validation weights of fold `fold`'s pretraining in an earlier `process` run's folder."""
-    ck = run / f"lstm_pretrain_fold{fold}.pt"
-    if not ck.exists():
-        raise ValueError(f"warm start: {ck} not found; the run must be a pretrained `process` run on the same store")
-    state = torch.load(ck, weights_only=False, map_location="cpu")["state"]
-    if state.get("best_weights") is None:
-        raise ValueError(f"warm start: {ck} holds no finished epoch")
-    return state["best_weights"]
+    try:
+        return training.best_weights(run / f"lstm_pretrain_fold{fold}.pt")
+    except ValueError as exc:
+        raise ValueError(f"warm start: {exc}; the run must be a pretrained `process` run on the same store") from exc
 
 
 def _window_mse(model, xw, yw, scaling: dict) -> float:
